@@ -1,0 +1,224 @@
+// Index arithmetic shared by every rank: global vertex keys over the whole extent, the local
+// sample layout of one piece, and which rank owns which cube.
+#ifndef rgmcGrid_h
+#define rgmcGrid_h
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace rgmc
+{
+
+/// An inclusive box of cube (cell) indices; empty when Lo > Hi on any axis.
+struct CellBox
+{
+  int Lo[3] = { 0, 0, 0 };
+  int Hi[3] = { -1, -1, -1 };
+
+  bool Empty() const { return Lo[0] > Hi[0] || Lo[1] > Hi[1] || Lo[2] > Hi[2]; }
+  bool Contains(int i, int j, int k) const
+  {
+    return i >= Lo[0] && i <= Hi[0] && j >= Lo[1] && j <= Hi[1] && k >= Lo[2] && k <= Hi[2];
+  }
+  std::int64_t Count() const
+  {
+    return this->Empty() ? 0
+                         : std::int64_t(Hi[0] - Lo[0] + 1) * (Hi[1] - Lo[1] + 1) * (Hi[2] - Lo[2] + 1);
+  }
+  CellBox Intersect(const CellBox& o) const
+  {
+    CellBox r;
+    for (int a = 0; a < 3; ++a)
+    {
+      r.Lo[a] = std::max(Lo[a], o.Lo[a]);
+      r.Hi[a] = std::min(Hi[a], o.Hi[a]);
+    }
+    return r;
+  }
+  CellBox Grown(int n) const
+  {
+    CellBox r = *this;
+    for (int a = 0; a < 3; ++a)
+    {
+      r.Lo[a] -= n;
+      r.Hi[a] += n;
+    }
+    return r;
+  }
+  bool ContainsBox(const CellBox& o) const
+  {
+    return o.Empty() || (Contains(o.Lo[0], o.Lo[1], o.Lo[2]) && Contains(o.Hi[0], o.Hi[1], o.Hi[2]));
+  }
+};
+
+/// Point extents use VTK's order (x0, x1, y0, y1, z0, z1), inclusive.
+class Grid
+{
+public:
+  Grid(const int whole[6], const int local[6])
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      this->WholeLo[a] = whole[2 * a];
+      this->WholeHi[a] = whole[2 * a + 1];
+      this->LocalLo[a] = local[2 * a];
+      this->LocalHi[a] = local[2 * a + 1];
+    }
+    this->WholeNx = this->WholeHi[0] - this->WholeLo[0] + 1;
+    this->WholeNxy = this->WholeNx * (this->WholeHi[1] - this->WholeLo[1] + 1);
+    this->NumPoints = this->WholeNxy * (this->WholeHi[2] - this->WholeLo[2] + 1);
+    this->StrideY = this->LocalHi[0] - this->LocalLo[0] + 1;
+    this->StrideZ = this->StrideY * (this->LocalHi[1] - this->LocalLo[1] + 1);
+  }
+
+  /// Global id of a grid point, the same on every rank.
+  std::int64_t PointId(int i, int j, int k) const
+  {
+    return (i - this->WholeLo[0]) + this->WholeNx * (j - this->WholeLo[1]) +
+      this->WholeNxy * (k - this->WholeLo[2]);
+  }
+
+  /// Key of the vertex on the edge that leaves grid point (i, j, k) along `axis`.
+  std::int64_t EdgeKey(int i, int j, int k, int axis) const
+  {
+    return 3 * this->PointId(i, j, k) + axis;
+  }
+
+  /// Key of a vertex that sits on grid point (i, j, k) (its sample equals the isovalue). Placed
+  /// after all edge keys so that the two kinds never collide.
+  std::int64_t PointKey(int i, int j, int k) const
+  {
+    return 3 * this->NumPoints + this->PointId(i, j, k);
+  }
+
+  bool IsPointKey(std::int64_t key) const { return key >= 3 * this->NumPoints; }
+
+  /// Inverse of EdgeKey / PointKey: the grid point and the axis (-1 for a point key).
+  void Decode(std::int64_t key, int p[3], int& axis) const
+  {
+    std::int64_t id;
+    if (this->IsPointKey(key))
+    {
+      id = key - 3 * this->NumPoints;
+      axis = -1;
+    }
+    else
+    {
+      id = key / 3;
+      axis = static_cast<int>(key % 3);
+    }
+    p[2] = static_cast<int>(id / this->WholeNxy) + this->WholeLo[2];
+    id %= this->WholeNxy;
+    p[1] = static_cast<int>(id / this->WholeNx) + this->WholeLo[1];
+    p[0] = static_cast<int>(id % this->WholeNx) + this->WholeLo[0];
+  }
+
+  /// Whether cube (i, j, k) lies inside the whole extent.
+  bool HasCell(int i, int j, int k) const
+  {
+    return i >= this->WholeLo[0] && i < this->WholeHi[0] && j >= this->WholeLo[1] &&
+      j < this->WholeHi[1] && k >= this->WholeLo[2] && k < this->WholeHi[2];
+  }
+
+  CellBox WholeCells() const
+  {
+    CellBox b;
+    for (int a = 0; a < 3; ++a)
+    {
+      b.Lo[a] = this->WholeLo[a];
+      b.Hi[a] = this->WholeHi[a] - 1;
+    }
+    return b;
+  }
+
+  bool LocalHasPoint(int i, int j, int k) const
+  {
+    return i >= this->LocalLo[0] && i <= this->LocalHi[0] && j >= this->LocalLo[1] &&
+      j <= this->LocalHi[1] && k >= this->LocalLo[2] && k <= this->LocalHi[2];
+  }
+
+  /// Index of grid point (i, j, k) in this piece's sample array.
+  std::int64_t LocalIndex(int i, int j, int k) const
+  {
+    return (i - this->LocalLo[0]) + this->StrideY * (j - this->LocalLo[1]) +
+      this->StrideZ * (k - this->LocalLo[2]);
+  }
+
+  int WholeLo[3], WholeHi[3];
+  int LocalLo[3], LocalHi[3];
+  std::int64_t WholeNx, WholeNxy, NumPoints;
+  std::int64_t StrideY, StrideZ;
+};
+
+/// Which rank owns each cube: the lowest rank whose box of non-ghost cells contains it. With
+/// ParaView's decompositions the boxes do not overlap; a reader that ignores piece requests can
+/// make them overlap, and then the lower rank wins.
+class Ownership
+{
+public:
+  Ownership() = default;
+  Ownership(std::vector<CellBox> boxes, int rank)
+    : Boxes(std::move(boxes))
+    , Rank(rank)
+  {
+    const CellBox& mine = this->Boxes[rank];
+    for (int r = 0; r < rank; ++r)
+    {
+      const CellBox overlap = mine.Intersect(this->Boxes[r]);
+      if (!overlap.Empty())
+      {
+        this->LowerOverlaps.push_back(overlap);
+        if (overlap.ContainsBox(mine))
+        {
+          this->CoveredByLower = true;
+        }
+      }
+    }
+  }
+
+  const CellBox& Mine() const { return this->Boxes[this->Rank]; }
+  bool OwnsNothing() const { return this->Mine().Empty() || this->CoveredByLower; }
+  const std::vector<CellBox>& Overlaps() const { return this->LowerOverlaps; }
+  int NumberOfRanks() const { return static_cast<int>(this->Boxes.size()); }
+  const CellBox& BoxOf(int rank) const { return this->Boxes[rank]; }
+
+  bool Owns(int i, int j, int k) const
+  {
+    if (!this->Mine().Contains(i, j, k))
+    {
+      return false;
+    }
+    for (const CellBox& b : this->LowerOverlaps)
+    {
+      if (b.Contains(i, j, k))
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  /// The owning rank of a cube, or -1 when no rank has it.
+  int Owner(int i, int j, int k) const
+  {
+    for (int r = 0; r < static_cast<int>(this->Boxes.size()); ++r)
+    {
+      if (this->Boxes[r].Contains(i, j, k))
+      {
+        return r;
+      }
+    }
+    return -1;
+  }
+
+private:
+  std::vector<CellBox> Boxes;
+  int Rank = 0;
+  std::vector<CellBox> LowerOverlaps;
+  bool CoveredByLower = false;
+};
+
+} // namespace rgmc
+
+#endif

@@ -1,0 +1,1043 @@
+// Region-growing marching cubes on one piece of a volume, without VTK.
+//
+// The surface graph: a node is one connected group of a cube's triangles (a sheet of the case
+// table, or in a cube with a sample equal to the isovalue, a group of the triangles that survive
+// collapsing); two nodes are adjacent when they share a vertex key. Growth visits, from a node,
+// every other cube that contains one of its vertices (3 cubes around an edge, 7 around a grid
+// point), so it reproduces exactly the connectivity of vtkMarchingCubes followed by
+// vtkPolyDataConnectivityFilter while touching only cubes the surface passes through.
+//
+// Each node is grown into a local component. Components that meet through a vertex this piece
+// cannot see whole (a cube around it belongs to another rank) record that vertex as a port; the
+// VTK layer matches ports across ranks and joins the components (vtkRGMarchingCubes).
+#ifndef rgmcGrower_h
+#define rgmcGrower_h
+
+#include "rgmcCaseTable.h"
+#include "rgmcGrid.h"
+#include "rgmcKeyMap.h"
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace rgmc
+{
+
+struct GrowerParams
+{
+  double Isovalue = 0.0;
+  bool ComputeNormals = true;
+  /// world = IndexToWorld * (i, j, k, 1): direction * spacing, then origin.
+  double IndexToWorld[3][4] = { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 } };
+  /// Maps an index-space gradient to a world-space normal before normalizing:
+  /// det(direction) * direction * diag(1 / spacing), as vtkImageTransform does.
+  double NormalToWorld[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  /// Called every few thousand nodes with a rough fraction done; returns true to abort.
+  std::function<bool(double)> Progress;
+};
+
+/// One local component: a union-find node with the statistics the global resolution needs.
+struct Component
+{
+  int Parent = 0;
+  bool Seeded = false;
+  std::int64_t Triangles = 0;
+  std::int64_t MinKey = std::numeric_limits<std::int64_t>::max();
+};
+
+/// A vertex that other ranks may also have: its key and the component that owns it here.
+struct Port
+{
+  std::int64_t Key;
+  int Component;
+};
+
+/// The surface vertex a seed selected on one rank: its squared distance, key and position.
+struct SeedHit
+{
+  bool Found = false;
+  double Distance2 = std::numeric_limits<double>::infinity();
+  std::int64_t Key = std::numeric_limits<std::int64_t>::max();
+  double Point[3] = { 0, 0, 0 };
+};
+
+/// What one piece produced: vertices (world coordinates in double, normals), triangles over
+/// them, and the local component of each triangle.
+struct LocalMesh
+{
+  std::vector<double> Points;
+  std::vector<float> Normals;
+  std::vector<std::int64_t> Keys;
+  std::vector<std::int32_t> VertexComponent;
+  std::vector<std::int32_t> Triangles;
+  std::vector<std::int32_t> TriangleComponent;
+
+  std::int64_t NumberOfPoints() const { return static_cast<std::int64_t>(this->Keys.size()); }
+  std::int64_t NumberOfTriangles() const
+  {
+    return static_cast<std::int64_t>(this->TriangleComponent.size());
+  }
+};
+
+template <typename Values>
+class Grower
+{
+public:
+  using ValueType = typename std::decay<decltype(std::declval<const Values&>()[0])>::type;
+
+  Grower(const CaseTable& table, const Grid& grid, const Ownership& ownership,
+    const Values& values, const GrowerParams& params)
+    : Table(table)
+    , G(grid)
+    , Own(ownership)
+    , Vals(values)
+    , P(params)
+    , C(params.Isovalue)
+  {
+    const CellBox& box = this->Own.Mine();
+    if (!box.Empty())
+    {
+      this->BoxNx = box.Hi[0] - box.Lo[0] + 1;
+      this->BoxNxy = this->BoxNx * (box.Hi[1] - box.Lo[1] + 1);
+      this->Visited.assign(static_cast<std::size_t>((box.Count() + 63) / 64), 0);
+    }
+    for (int v = 0; v < 8; ++v)
+    {
+      this->CornerStride[v] = CornerOffset[v][0] + this->G.StrideY * CornerOffset[v][1] +
+        this->G.StrideZ * CornerOffset[v][2];
+    }
+    for (int e = 0; e < 12; ++e)
+    {
+      this->EdgeAxisOf[e] = CaseTable::EdgeAxis(e);
+    }
+  }
+
+  // ---- results -------------------------------------------------------------------------------
+  LocalMesh Mesh;
+  std::vector<Component> Components;
+  std::vector<Port> Ports;
+
+  /// Empty unless a sample was not a number (the message names the grid point).
+  const std::string& Error() const { return this->ErrorText; }
+  bool Aborted() const { return this->AbortFlag; }
+  /// True when a gradient needed a sample beyond this piece that lies inside the volume (the
+  /// input lacked its ghost layer); such normals are one-sided.
+  bool MissingGhosts() const { return this->GhostsMissing; }
+  bool Stopped() const { return this->AbortFlag || !this->ErrorText.empty(); }
+
+  int Root(int c)
+  {
+    while (this->Components[c].Parent != c)
+    {
+      const int grand = this->Components[this->Components[c].Parent].Parent;
+      this->Components[c].Parent = grand;
+      c = grand;
+    }
+    return c;
+  }
+
+  int AddComponent(bool seeded)
+  {
+    Component comp;
+    comp.Parent = static_cast<int>(this->Components.size());
+    comp.Seeded = seeded;
+    this->Components.push_back(comp);
+    return comp.Parent;
+  }
+
+  // ---- seed search ---------------------------------------------------------------------------
+  /// The surface vertex nearest to a seed among the cubes this piece owns, ties broken by the
+  /// smaller key. `seedIndex` is the seed in continuous index coordinates (inside the volume),
+  /// `seedWorld` the same point in world coordinates. Only vertices within `radius` count.
+  /// `minStep` is a lower bound of the world length of any index step of length 1 (the
+  /// smallest singular value of direction * spacing); it bounds the search shells.
+  SeedHit NearestVertex(const double seedIndex[3], const double seedWorld[3], double radius,
+    double minStep)
+  {
+    SeedHit best;
+    if (this->Own.OwnsNothing())
+    {
+      return best;
+    }
+    const CellBox& box = this->Own.Mine();
+    int c[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      c[a] = static_cast<int>(std::floor(seedIndex[a]));
+      c[a] = std::max(this->G.WholeLo[a], std::min(this->G.WholeHi[a] - 1, c[a]));
+    }
+    const double radius2 = radius * radius;
+    auto consider = [&](std::int64_t key, const double x[3]) {
+      const double d2 = Distance2(x, seedWorld);
+      if (d2 <= radius2 && (d2 < best.Distance2 || (d2 == best.Distance2 && key < best.Key)))
+      {
+        best.Found = true;
+        best.Distance2 = d2;
+        best.Key = key;
+        best.Point[0] = x[0];
+        best.Point[1] = x[1];
+        best.Point[2] = x[2];
+      }
+    };
+
+    CubeState st;
+    Groups groups;
+    for (int r = 0;; ++r)
+    {
+      if (r >= 1)
+      {
+        // Every vertex of shell r or beyond is at least (r - 1) index steps away.
+        const double bound = (r - 1) * minStep;
+        if (bound > radius || (best.Found && std::sqrt(best.Distance2) < bound))
+        {
+          break;
+        }
+      }
+      CellBox shell;
+      for (int a = 0; a < 3; ++a)
+      {
+        shell.Lo[a] = c[a] - r;
+        shell.Hi[a] = c[a] + r;
+      }
+      const CellBox clip = shell.Intersect(box);
+      if (!clip.Empty())
+      {
+        this->ForShell(clip, c, r, [&](int i, int j, int k) {
+          if (this->Stopped() || !this->Own.Owns(i, j, k) || !this->Evaluate(i, j, k, st))
+          {
+            return;
+          }
+          if (st.Case == 0 || st.Case == 255)
+          {
+            return;
+          }
+          double x[3];
+          if (!st.Degenerate)
+          {
+            const CaseEntry& ce = this->Table[st.Case];
+            for (int e = 0; e < 12; ++e)
+            {
+              if (ce.CutEdges & (1u << e))
+              {
+                int p[3];
+                this->EdgeLowPoint(i, j, k, e, p);
+                this->EdgePosition(p, this->EdgeAxisOf[e], st.S[EdgeCorners[e][0]],
+                  st.S[EdgeCorners[e][1]], x);
+                consider(this->G.EdgeKey(p[0], p[1], p[2], this->EdgeAxisOf[e]), x);
+              }
+            }
+          }
+          else
+          {
+            this->ComputeGroups(i, j, k, st, groups);
+            for (int t = 0; t < groups.NumTriangles; ++t)
+            {
+              for (int v = 0; v < 3; ++v)
+              {
+                this->KeyPosition(groups.Keys[t][v], st, i, j, k, groups.Edges[t][v], x);
+                consider(groups.Keys[t][v], x);
+              }
+            }
+          }
+        });
+      }
+      if (shell.ContainsBox(box) || this->Stopped())
+      {
+        break;
+      }
+    }
+    return best;
+  }
+
+  // ---- growth --------------------------------------------------------------------------------
+
+  /// Grows the component that contains the vertex `key` from the nodes of this piece that use
+  /// it. Returns that component (a new one, or the one that already holds the vertex), or -1
+  /// when no cube this piece owns has the vertex.
+  int GrowFromKey(std::int64_t key)
+  {
+    if (const std::int32_t* existing = this->VertexIds.Find(key))
+    {
+      return this->Root(this->Mesh.VertexComponent[*existing]);
+    }
+    const int comp = this->AddComponent(false);
+    const std::size_t before = this->Stack.size();
+    int p[3], axis;
+    this->G.Decode(key, p, axis);
+    this->VisitAroundKey(key, p, axis, nullptr);
+    if (this->Stack.size() == before)
+    {
+      this->Components.pop_back();
+      return -1;
+    }
+    this->Drain(comp);
+    return this->Root(comp);
+  }
+
+  /// Labels every component that has a node in an owned cube (a full scan: the "All" and
+  /// "Largest" modes).
+  void GrowAll()
+  {
+    if (!this->Own.OwnsNothing())
+    {
+      this->Scan(this->Own.Mine(), true);
+    }
+  }
+
+  /// Grows every component that has a node in an owned cube next to a cube of another rank:
+  /// the other half of the distributed seeded growth, which lets every rank work at once.
+  void GrowBoundary()
+  {
+    if (this->Own.OwnsNothing())
+    {
+      return;
+    }
+    const CellBox& box = this->Own.Mine();
+    const CellBox whole = this->G.WholeCells();
+    for (int a = 0; a < 3 && !this->Stopped(); ++a)
+    {
+      for (int side = 0; side < 2; ++side)
+      {
+        const bool neighbourExists =
+          side == 0 ? box.Lo[a] > whole.Lo[a] : box.Hi[a] < whole.Hi[a];
+        if (!neighbourExists)
+        {
+          continue;
+        }
+        CellBox layer = box;
+        layer.Lo[a] = layer.Hi[a] = side == 0 ? box.Lo[a] : box.Hi[a];
+        this->Scan(layer, false);
+      }
+    }
+    for (const CellBox& lower : this->Own.Overlaps())
+    {
+      this->Scan(lower.Grown(1).Intersect(box), false);
+    }
+  }
+
+private:
+  struct CubeState
+  {
+    int Case = 0;
+    bool Degenerate = false;
+    double S[8];
+  };
+
+  /// The triangles of a cube with a sample equal to the isovalue, after collapsing vertices
+  /// onto grid points and dropping the triangles that collapse, grouped by shared keys.
+  struct Groups
+  {
+    int NumTriangles = 0;
+    int NumGroups = 0;
+    std::int64_t Keys[MaxTriangles][3];
+    std::int8_t Edges[MaxTriangles][3];
+    int Group[MaxTriangles];
+  };
+
+  struct Node
+  {
+    int I, J, K;
+    int Group;
+  };
+
+  static double Distance2(const double a[3], const double b[3])
+  {
+    const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    return dx * dx + dy * dy + dz * dz;
+  }
+
+  /// The sample at grid point (i, j, k) of this piece; a NaN stops the growth with an error.
+  double Read(int i, int j, int k)
+  {
+    const double s = static_cast<double>(this->Vals[this->G.LocalIndex(i, j, k)]);
+    if (!std::is_integral<ValueType>::value && s != s)
+    {
+      this->Fail(i, j, k);
+    }
+    return s;
+  }
+
+  void Fail(int i, int j, int k)
+  {
+    if (this->ErrorText.empty())
+    {
+      std::ostringstream msg;
+      msg << "the scalar value at grid point (" << i << ", " << j << ", " << k
+          << ") is NaN; replace NaN samples (for example with the Threshold or Calculator "
+             "filter) before extracting a surface";
+      this->ErrorText = msg.str();
+    }
+  }
+
+  /// Reads the 8 corners of cube (i, j, k); false when a sample is NaN.
+  bool Evaluate(int i, int j, int k, CubeState& st)
+  {
+    const std::int64_t base = this->G.LocalIndex(i, j, k);
+    int code = 0;
+    bool degenerate = false;
+    for (int v = 0; v < 8; ++v)
+    {
+      const double s = static_cast<double>(this->Vals[base + this->CornerStride[v]]);
+      if (!std::is_integral<ValueType>::value && s != s)
+      {
+        this->Fail(i + CornerOffset[v][0], j + CornerOffset[v][1], k + CornerOffset[v][2]);
+        return false;
+      }
+      st.S[v] = s;
+      code |= (s >= this->C) << v;
+      degenerate |= (s == this->C);
+    }
+    st.Case = code;
+    st.Degenerate = degenerate;
+    return true;
+  }
+
+  void EdgeLowPoint(int i, int j, int k, int e, int p[3]) const
+  {
+    const int* o = CornerOffset[EdgeCorners[e][0]];
+    p[0] = i + o[0];
+    p[1] = j + o[1];
+    p[2] = k + o[2];
+  }
+
+  /// The key of the vertex on edge e of cube (i, j, k): the grid point's own key when that
+  /// end's sample equals the isovalue.
+  std::int64_t VertexKeyOf(int i, int j, int k, int e, const CubeState& st) const
+  {
+    const int lo = EdgeCorners[e][0], hi = EdgeCorners[e][1];
+    if (st.S[lo] == this->C)
+    {
+      return this->G.PointKey(
+        i + CornerOffset[lo][0], j + CornerOffset[lo][1], k + CornerOffset[lo][2]);
+    }
+    if (st.S[hi] == this->C)
+    {
+      return this->G.PointKey(
+        i + CornerOffset[hi][0], j + CornerOffset[hi][1], k + CornerOffset[hi][2]);
+    }
+    int p[3];
+    this->EdgeLowPoint(i, j, k, e, p);
+    return this->G.EdgeKey(p[0], p[1], p[2], this->EdgeAxisOf[e]);
+  }
+
+  void ComputeGroups(int i, int j, int k, const CubeState& st, Groups& g) const
+  {
+    const CaseEntry& ce = this->Table[st.Case];
+    g.NumTriangles = 0;
+    for (int t = 0; t < ce.NumTriangles; ++t)
+    {
+      std::int64_t keys[3];
+      for (int v = 0; v < 3; ++v)
+      {
+        keys[v] = this->VertexKeyOf(i, j, k, ce.Triangles[t][v], st);
+      }
+      if (keys[0] == keys[1] || keys[0] == keys[2] || keys[1] == keys[2])
+      {
+        continue; // collapsed onto a grid point: vtkMarchingCubes drops it too
+      }
+      for (int v = 0; v < 3; ++v)
+      {
+        g.Keys[g.NumTriangles][v] = keys[v];
+        g.Edges[g.NumTriangles][v] = ce.Triangles[t][v];
+      }
+      ++g.NumTriangles;
+    }
+    int parent[MaxTriangles];
+    for (int t = 0; t < g.NumTriangles; ++t)
+    {
+      parent[t] = t;
+    }
+    auto find = [&parent](int x) {
+      while (parent[x] != x)
+      {
+        x = parent[x];
+      }
+      return x;
+    };
+    for (int a = 0; a < g.NumTriangles; ++a)
+    {
+      for (int b = a + 1; b < g.NumTriangles; ++b)
+      {
+        for (int va = 0; va < 3; ++va)
+        {
+          for (int vb = 0; vb < 3; ++vb)
+          {
+            if (g.Keys[a][va] == g.Keys[b][vb])
+            {
+              parent[find(a)] = find(b);
+            }
+          }
+        }
+      }
+    }
+    int groupOfRoot[MaxTriangles];
+    for (int t = 0; t < g.NumTriangles; ++t)
+    {
+      groupOfRoot[t] = -1;
+    }
+    g.NumGroups = 0;
+    for (int t = 0; t < g.NumTriangles; ++t)
+    {
+      const int root = find(t);
+      if (groupOfRoot[root] < 0)
+      {
+        groupOfRoot[root] = g.NumGroups++;
+      }
+      g.Group[t] = groupOfRoot[root];
+    }
+  }
+
+  static bool GroupHasKey(const Groups& g, int group, std::int64_t key)
+  {
+    for (int t = 0; t < g.NumTriangles; ++t)
+    {
+      if (g.Group[t] == group && (g.Keys[t][0] == key || g.Keys[t][1] == key || g.Keys[t][2] == key))
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // ---- geometry (bitwise identical on every rank: computed from global indices only) --------
+
+  void ToWorld(const double idx[3], double x[3]) const
+  {
+    const auto& m = this->P.IndexToWorld;
+    for (int r = 0; r < 3; ++r)
+    {
+      x[r] = m[r][0] * idx[0] + m[r][1] * idx[1] + m[r][2] * idx[2] + m[r][3];
+    }
+  }
+
+  /// The vertex on the edge leaving grid point p along `axis`, interpolated from the lower end
+  /// as vtkMarchingCubes does (x = p_lo + t (p_hi - p_lo)).
+  double EdgePosition(const int p[3], int axis, double sLo, double sHi, double x[3]) const
+  {
+    const double t = (this->C - sLo) / (sHi - sLo);
+    double idx[3] = { double(p[0]), double(p[1]), double(p[2]) };
+    idx[axis] = idx[axis] + t * 1.0;
+    this->ToWorld(idx, x);
+    return t;
+  }
+
+  void KeyPosition(std::int64_t key, const CubeState& st, int i, int j, int k, int e, double x[3])
+  {
+    int p[3], axis;
+    this->G.Decode(key, p, axis);
+    if (axis < 0)
+    {
+      const double idx[3] = { double(p[0]), double(p[1]), double(p[2]) };
+      this->ToWorld(idx, x);
+    }
+    else
+    {
+      (void)i;
+      (void)j;
+      (void)k;
+      this->EdgePosition(p, axis, st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], x);
+    }
+  }
+
+  /// Negative gradient at a grid point by central differences, one-sided on the volume's
+  /// border, as vtkMarchingCubes computes it.
+  void Gradient(int i, int j, int k, double n[3])
+  {
+    const int p[3] = { i, j, k };
+    const double s0 = this->Read(i, j, k);
+    for (int a = 0; a < 3; ++a)
+    {
+      bool hasLow = p[a] > this->G.WholeLo[a];
+      bool hasHigh = p[a] < this->G.WholeHi[a];
+      if (hasLow && p[a] - 1 < this->G.LocalLo[a])
+      {
+        hasLow = false;
+        this->GhostsMissing = true;
+      }
+      if (hasHigh && p[a] + 1 > this->G.LocalHi[a])
+      {
+        hasHigh = false;
+        this->GhostsMissing = true;
+      }
+      int lo[3] = { i, j, k }, hi[3] = { i, j, k };
+      --lo[a];
+      ++hi[a];
+      if (hasLow && hasHigh)
+      {
+        n[a] = 0.5 * (this->Read(lo[0], lo[1], lo[2]) - this->Read(hi[0], hi[1], hi[2]));
+      }
+      else if (hasHigh)
+      {
+        n[a] = s0 - this->Read(hi[0], hi[1], hi[2]);
+      }
+      else if (hasLow)
+      {
+        n[a] = this->Read(lo[0], lo[1], lo[2]) - s0;
+      }
+      else
+      {
+        n[a] = 0.0;
+      }
+    }
+  }
+
+  void FinishNormal(const double n[3], float out[3]) const
+  {
+    const auto& m = this->P.NormalToWorld;
+    double w[3];
+    for (int r = 0; r < 3; ++r)
+    {
+      w[r] = m[r][0] * n[0] + m[r][1] * n[1] + m[r][2] * n[2];
+    }
+    const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (len > 0.0)
+    {
+      w[0] /= len;
+      w[1] /= len;
+      w[2] /= len;
+    }
+    out[0] = static_cast<float>(w[0]);
+    out[1] = static_cast<float>(w[1]);
+    out[2] = static_cast<float>(w[2]);
+  }
+
+  // ---- vertices ------------------------------------------------------------------------------
+
+  /// The output point of a vertex key, created (position, normal, port check) on first use.
+  /// Meeting a vertex another component created joins the two components.
+  std::int32_t Vertex(std::int64_t key, const int p[3], int axis, double sLo, double sHi, int comp)
+  {
+    bool inserted;
+    const std::int32_t fresh = static_cast<std::int32_t>(this->Mesh.Keys.size());
+    std::int32_t& slot = this->VertexIds.FindOrInsert(key, fresh, inserted);
+    if (!inserted)
+    {
+      const std::int32_t id = slot;
+      this->Join(this->Mesh.VertexComponent[id], comp);
+      return id;
+    }
+    double x[3];
+    float normal[3] = { 0, 0, 0 };
+    if (axis < 0)
+    {
+      const double idx[3] = { double(p[0]), double(p[1]), double(p[2]) };
+      this->ToWorld(idx, x);
+      if (this->P.ComputeNormals)
+      {
+        double g[3];
+        this->Gradient(p[0], p[1], p[2], g);
+        this->FinishNormal(g, normal);
+      }
+    }
+    else
+    {
+      const double t = this->EdgePosition(p, axis, sLo, sHi, x);
+      if (this->P.ComputeNormals)
+      {
+        double g0[3], g1[3], g[3];
+        int q[3] = { p[0], p[1], p[2] };
+        this->Gradient(q[0], q[1], q[2], g0);
+        ++q[axis];
+        this->Gradient(q[0], q[1], q[2], g1);
+        for (int a = 0; a < 3; ++a)
+        {
+          g[a] = g0[a] + t * (g1[a] - g0[a]);
+        }
+        this->FinishNormal(g, normal);
+      }
+    }
+    LocalMesh& m = this->Mesh;
+    m.Points.insert(m.Points.end(), x, x + 3);
+    m.Normals.insert(m.Normals.end(), normal, normal + 3);
+    m.Keys.push_back(key);
+    m.VertexComponent.push_back(comp);
+    Component& c = this->Components[this->Root(comp)];
+    c.MinKey = std::min(c.MinKey, key);
+    if (this->IsPort(p, axis))
+    {
+      this->Ports.push_back(Port{ key, comp });
+    }
+    return fresh;
+  }
+
+  std::int32_t EdgeVertex(int i, int j, int k, int e, const CubeState& st, int comp)
+  {
+    int p[3];
+    this->EdgeLowPoint(i, j, k, e, p);
+    const int axis = this->EdgeAxisOf[e];
+    return this->Vertex(this->G.EdgeKey(p[0], p[1], p[2], axis), p, axis,
+      st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], comp);
+  }
+
+  std::int32_t KeyVertex(std::int64_t key, int e, const CubeState& st, int comp)
+  {
+    int p[3], axis;
+    this->G.Decode(key, p, axis);
+    return this->Vertex(key, p, axis, st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], comp);
+  }
+
+  /// Whether a cube that contains this vertex lies in the volume but not in this rank's cubes.
+  bool IsPort(const int p[3], int axis) const
+  {
+    for (int d = 0; d < 8; ++d)
+    {
+      const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
+      if (axis >= 0 && o[axis] != 0)
+      {
+        continue; // an edge lies in the 4 cubes around it, not 8
+      }
+      const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
+      if (this->G.HasCell(i, j, k) && !this->Own.Owns(i, j, k))
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void Join(int a, int b)
+  {
+    a = this->Root(a);
+    b = this->Root(b);
+    if (a == b)
+    {
+      return;
+    }
+    if (b < a)
+    {
+      std::swap(a, b);
+    }
+    Component& keep = this->Components[a];
+    const Component& gone = this->Components[b];
+    keep.Seeded = keep.Seeded || gone.Seeded;
+    keep.Triangles += gone.Triangles;
+    keep.MinKey = std::min(keep.MinKey, gone.MinKey);
+    this->Components[b].Parent = a;
+  }
+
+  void AddTriangle(const std::int32_t ids[3], int comp)
+  {
+    LocalMesh& m = this->Mesh;
+    m.Triangles.insert(m.Triangles.end(), ids, ids + 3);
+    m.TriangleComponent.push_back(comp);
+    ++this->Components[this->Root(comp)].Triangles;
+  }
+
+  // ---- visiting ------------------------------------------------------------------------------
+
+  std::int64_t BoxIndex(int i, int j, int k) const
+  {
+    const CellBox& b = this->Own.Mine();
+    return (i - b.Lo[0]) + this->BoxNx * (j - b.Lo[1]) + this->BoxNxy * (k - b.Lo[2]);
+  }
+
+  bool Done(std::int64_t bit) const { return (this->Visited[bit >> 6] >> (bit & 63)) & 1u; }
+  void SetDone(std::int64_t bit) { this->Visited[bit >> 6] |= std::uint64_t(1) << (bit & 63); }
+
+  bool GroupVisited(std::int64_t bit, int group, int numGroups) const
+  {
+    if (this->Done(bit))
+    {
+      return true;
+    }
+    if (numGroups == 1)
+    {
+      return false;
+    }
+    const std::int32_t* mask = this->MultiGroup.Find(bit);
+    return mask && ((*mask >> group) & 1);
+  }
+
+  /// Marks node (cube, group) visited and queues it. Cubes with one node use only the bit per
+  /// cube; cubes with several remember which nodes were taken until all are.
+  void Mark(int i, int j, int k, std::int64_t bit, int group, int numGroups)
+  {
+    if (numGroups == 1)
+    {
+      this->SetDone(bit);
+    }
+    else
+    {
+      bool inserted;
+      std::int32_t& mask = this->MultiGroup.FindOrInsert(bit, 0, inserted);
+      if ((mask >> group) & 1)
+      {
+        return;
+      }
+      mask |= 1 << group;
+      if (mask == (1 << numGroups) - 1)
+      {
+        this->SetDone(bit);
+      }
+    }
+    this->Stack.push_back(Node{ i, j, k, group });
+  }
+
+  /// Queues the nodes of cube (i, j, k) that use vertex `key`. `edge` is the cube's local edge
+  /// carrying the vertex (ignored for a grid-point key).
+  void Visit(int i, int j, int k, std::int64_t key, int edge)
+  {
+    if (!this->G.HasCell(i, j, k) || !this->Own.Owns(i, j, k))
+    {
+      return;
+    }
+    const std::int64_t bit = this->BoxIndex(i, j, k);
+    if (this->Done(bit))
+    {
+      return;
+    }
+    CubeState st;
+    if (!this->Evaluate(i, j, k, st))
+    {
+      return;
+    }
+    if (!st.Degenerate)
+    {
+      const CaseEntry& ce = this->Table[st.Case];
+      const int sheet = edge >= 0 ? ce.EdgeSheet[edge] : -1;
+      if (sheet >= 0)
+      {
+        this->Mark(i, j, k, bit, sheet, ce.NumSheets);
+      }
+      return;
+    }
+    Groups g;
+    this->ComputeGroups(i, j, k, st, g);
+    for (int group = 0; group < g.NumGroups; ++group)
+    {
+      if (GroupHasKey(g, group, key) && !this->GroupVisited(bit, group, g.NumGroups))
+      {
+        this->Mark(i, j, k, bit, group, g.NumGroups);
+      }
+    }
+  }
+
+  /// Visits every cube that contains the vertex `key` (at grid point p; `axis` < 0 for a
+  /// grid-point vertex), except `from`.
+  void VisitAroundKey(std::int64_t key, const int p[3], int axis, const int* from)
+  {
+    for (int d = 0; d < 8; ++d)
+    {
+      const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
+      if (axis >= 0 && o[axis] != 0)
+      {
+        continue;
+      }
+      const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
+      if (from && i == from[0] && j == from[1] && k == from[2])
+      {
+        continue;
+      }
+      int edge = -1;
+      if (axis >= 0)
+      {
+        const int u = axis == 0 ? 1 : 0;
+        const int v = axis == 2 ? 1 : 2;
+        edge = this->EdgeAt[axis][o[u]][o[v]];
+      }
+      this->Visit(i, j, k, key, edge);
+    }
+  }
+
+  /// Emits the triangles of one node and queues its neighbours.
+  void Process(const Node& n, int comp)
+  {
+    CubeState st;
+    if (!this->Evaluate(n.I, n.J, n.K, st))
+    {
+      return;
+    }
+    const int from[3] = { n.I, n.J, n.K };
+    if (!st.Degenerate)
+    {
+      const CaseEntry& ce = this->Table[st.Case];
+      for (int t = 0; t < ce.NumTriangles; ++t)
+      {
+        if (ce.TriangleSheet[t] != n.Group)
+        {
+          continue;
+        }
+        std::int32_t ids[3];
+        for (int v = 0; v < 3; ++v)
+        {
+          ids[v] = this->EdgeVertex(n.I, n.J, n.K, ce.Triangles[t][v], st, comp);
+        }
+        this->AddTriangle(ids, comp);
+      }
+      unsigned edges = ce.SheetEdges[n.Group];
+      while (edges)
+      {
+        const int e = __builtin_ctz(edges);
+        edges &= edges - 1;
+        int p[3];
+        this->EdgeLowPoint(n.I, n.J, n.K, e, p);
+        const int axis = this->EdgeAxisOf[e];
+        this->VisitAroundKey(this->G.EdgeKey(p[0], p[1], p[2], axis), p, axis, from);
+      }
+      return;
+    }
+    Groups g;
+    this->ComputeGroups(n.I, n.J, n.K, st, g);
+    std::int64_t seen[3 * MaxTriangles];
+    int numSeen = 0;
+    for (int t = 0; t < g.NumTriangles; ++t)
+    {
+      if (g.Group[t] != n.Group)
+      {
+        continue;
+      }
+      std::int32_t ids[3];
+      for (int v = 0; v < 3; ++v)
+      {
+        ids[v] = this->KeyVertex(g.Keys[t][v], g.Edges[t][v], st, comp);
+        bool known = false;
+        for (int s = 0; s < numSeen; ++s)
+        {
+          known = known || seen[s] == g.Keys[t][v];
+        }
+        if (!known)
+        {
+          seen[numSeen++] = g.Keys[t][v];
+        }
+      }
+      this->AddTriangle(ids, comp);
+    }
+    for (int s = 0; s < numSeen; ++s)
+    {
+      int p[3], axis;
+      this->G.Decode(seen[s], p, axis);
+      this->VisitAroundKey(seen[s], p, axis, from);
+    }
+  }
+
+  void Drain(int comp)
+  {
+    while (!this->Stack.empty() && !this->Stopped())
+    {
+      const Node n = this->Stack.back();
+      this->Stack.pop_back();
+      this->Process(n, comp);
+      if ((++this->NodesProcessed & 0x3fff) == 0 && this->P.Progress)
+      {
+        const double done = static_cast<double>(this->NodesProcessed);
+        if (this->P.Progress(done / (done + 4.0 * this->Stack.size() + (1 << 20))))
+        {
+          this->AbortFlag = true;
+        }
+      }
+    }
+    this->Stack.clear();
+  }
+
+  /// Starts a new component from every unvisited node of the owned cubes in `region`.
+  void Scan(const CellBox& region, bool reportProgress)
+  {
+    CubeState st;
+    Groups g;
+    for (int k = region.Lo[2]; k <= region.Hi[2] && !this->Stopped(); ++k)
+    {
+      if (reportProgress && this->P.Progress &&
+        this->P.Progress(double(k - region.Lo[2]) / (region.Hi[2] - region.Lo[2] + 1)))
+      {
+        this->AbortFlag = true;
+        break;
+      }
+      for (int j = region.Lo[1]; j <= region.Hi[1]; ++j)
+      {
+        for (int i = region.Lo[0]; i <= region.Hi[0] && !this->Stopped(); ++i)
+        {
+          if (!this->Own.Owns(i, j, k))
+          {
+            continue;
+          }
+          const std::int64_t bit = this->BoxIndex(i, j, k);
+          if (this->Done(bit) || !this->Evaluate(i, j, k, st) || st.Case == 0 || st.Case == 255)
+          {
+            continue;
+          }
+          int numGroups = this->Table[st.Case].NumSheets;
+          if (st.Degenerate)
+          {
+            this->ComputeGroups(i, j, k, st, g);
+            numGroups = g.NumGroups;
+          }
+          for (int group = 0; group < numGroups; ++group)
+          {
+            if (!this->GroupVisited(bit, group, numGroups))
+            {
+              const int comp = this->AddComponent(false);
+              this->Mark(i, j, k, bit, group, numGroups);
+              this->Drain(comp);
+            }
+          }
+        }
+      }
+    }
+  }
+
+  /// Calls f(i, j, k) for the cubes of `clip` at Chebyshev distance exactly r from cube c.
+  template <typename F>
+  void ForShell(const CellBox& clip, const int c[3], int r, F&& f)
+  {
+    for (int k = clip.Lo[2]; k <= clip.Hi[2]; ++k)
+    {
+      for (int j = clip.Lo[1]; j <= clip.Hi[1]; ++j)
+      {
+        if (std::abs(k - c[2]) == r || std::abs(j - c[1]) == r)
+        {
+          for (int i = clip.Lo[0]; i <= clip.Hi[0]; ++i)
+          {
+            f(i, j, k);
+          }
+        }
+        else
+        {
+          if (c[0] - r >= clip.Lo[0])
+          {
+            f(c[0] - r, j, k);
+          }
+          if (r > 0 && c[0] + r <= clip.Hi[0])
+          {
+            f(c[0] + r, j, k);
+          }
+        }
+      }
+    }
+  }
+
+  const CaseTable& Table;
+  const Grid& G;
+  const Ownership& Own;
+  const Values& Vals;
+  GrowerParams P;
+  const double C;
+
+  std::int64_t CornerStride[8];
+  int EdgeAxisOf[12];
+  const int EdgeAt[3][2][2] = { { { CaseTable::EdgeAt(0, 0, 0), CaseTable::EdgeAt(0, 0, 1) },
+                                  { CaseTable::EdgeAt(0, 1, 0), CaseTable::EdgeAt(0, 1, 1) } },
+    { { CaseTable::EdgeAt(1, 0, 0), CaseTable::EdgeAt(1, 0, 1) },
+      { CaseTable::EdgeAt(1, 1, 0), CaseTable::EdgeAt(1, 1, 1) } },
+    { { CaseTable::EdgeAt(2, 0, 0), CaseTable::EdgeAt(2, 0, 1) },
+      { CaseTable::EdgeAt(2, 1, 0), CaseTable::EdgeAt(2, 1, 1) } } };
+
+  std::int64_t BoxNx = 0, BoxNxy = 0;
+  std::vector<std::uint64_t> Visited;
+  KeyMap MultiGroup{ 64 };
+  KeyMap VertexIds{ 1 << 16 };
+  std::vector<Node> Stack;
+  std::int64_t NodesProcessed = 0;
+  std::string ErrorText;
+  bool AbortFlag = false;
+  bool GhostsMissing = false;
+};
+
+} // namespace rgmc
+
+#endif

@@ -1,0 +1,274 @@
+// A CT-like head phantom built from signed distance functions, sampled with partial-volume
+// ramps and deterministic per-voxel noise.
+#include "vtkRGPhantomSource.h"
+
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkShortArray.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+vtkStandardNewMacro(vtkRGPhantomSource);
+
+namespace
+{
+
+constexpr double Pi = 3.14159265358979323846;
+
+double Length3(double x, double y, double z)
+{
+  return std::sqrt(x * x + y * y + z * z);
+}
+
+/// Signed distance (approximate, exact on the axes) to an axis-aligned ellipsoid.
+double EllipsoidSd(const double p[3], const double c[3], const double r[3])
+{
+  const double q = Length3((p[0] - c[0]) / r[0], (p[1] - c[1]) / r[1], (p[2] - c[2]) / r[2]);
+  return (q - 1.0) * std::min(r[0], std::min(r[1], r[2]));
+}
+
+/// Signed distance to an infinite cylinder along `axis` through (c) with radius r.
+double CylinderSd(const double p[3], int axis, const double c[3], double r)
+{
+  double d2 = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (a != axis)
+    {
+      d2 += (p[a] - c[a]) * (p[a] - c[a]);
+    }
+  }
+  return std::sqrt(d2) - r;
+}
+
+/// Weight of "inside" across a boundary ramp of the given width.
+double Inside(double sd, double ramp)
+{
+  return std::max(0.0, std::min(1.0, 0.5 - sd / ramp));
+}
+
+void Mix(double& value, double target, double weight)
+{
+  value += weight * (target - value);
+}
+
+// The anatomy, in mm. The cranium is a shell between two ellipsoids.
+const double HeadC[3] = { 0, 5, 0 }, HeadR[3] = { 80, 100, 115 };
+const double SkullC[3] = { 0, 0, 25 }, SkullOuter[3] = { 72, 90, 80 },
+             SkullInner[3] = { 65, 83, 73 };
+const double VentricleR[3] = { 6, 20, 10 };
+const double EyeR = 12;
+
+std::uint64_t SplitMix(std::uint64_t x)
+{
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+/// A standard normal sample from a voxel's global index (Box-Muller on hashed uniforms).
+double Noise(std::uint64_t index, int seed)
+{
+  const std::uint64_t h1 = SplitMix(index * 2 + (std::uint64_t(std::uint32_t(seed)) << 40));
+  const std::uint64_t h2 = SplitMix(h1 ^ 0xD1B54A32D192ED03ull);
+  const double u1 = (double(h1 >> 11) + 1.0) / 9007199254740993.0; // (0, 1]
+  const double u2 = double(h2 >> 11) / 9007199254740992.0;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * Pi * u2);
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkRGPhantomSource::vtkRGPhantomSource()
+{
+  this->SetNumberOfInputPorts(0);
+}
+
+double vtkRGPhantomSource::Spacing() const
+{
+  const int longest = std::max(this->Dimensions[0], std::max(this->Dimensions[1], this->Dimensions[2]));
+  return this->FieldOfView / std::max(1, longest);
+}
+
+double vtkRGPhantomSource::Ramp() const
+{
+  return std::max(1.2, 1.5 * this->Spacing());
+}
+
+//------------------------------------------------------------------------------
+double vtkRGPhantomSource::Evaluate(const double p[3]) const
+{
+  const double ramp = this->Ramp();
+  double v = -1000.0; // air
+
+  const double head = EllipsoidSd(p, HeadC, HeadR);
+  if (head > ramp)
+  {
+    return v;
+  }
+  Mix(v, 40.0, Inside(head, ramp));
+
+  // Brain and ventricles inside the cranium; eyes in front of the orbits.
+  const double inner = EllipsoidSd(p, SkullC, SkullInner);
+  if (inner < ramp)
+  {
+    Mix(v, 35.0, Inside(inner, ramp));
+    for (int side = -1; side <= 1; side += 2)
+    {
+      const double c[3] = { 8.0 * side, 5, 30 };
+      Mix(v, 8.0, Inside(EllipsoidSd(p, c, VentricleR), ramp));
+    }
+  }
+  for (int side = -1; side <= 1; side += 2)
+  {
+    const double c[3] = { 28.0 * side, 80, 20 };
+    const double r[3] = { EyeR, EyeR, EyeR };
+    Mix(v, 15.0, Inside(EllipsoidSd(p, c, r), ramp));
+  }
+
+  // The cranium: a shell with holes, its density varying as cortical bone does.
+  const double outer = EllipsoidSd(p, SkullC, SkullOuter);
+  if (outer < ramp)
+  {
+    double sd = std::max(outer, -inner);
+    const double foramen[3] = { 0, -15, 0 };
+    sd = std::max(sd, -std::max(CylinderSd(p, 2, foramen, 15), p[2] - 0.0));
+    for (int side = -1; side <= 1; side += 2)
+    {
+      const double orbit[3] = { 28.0 * side, 0, 20 };
+      sd = std::max(sd, -std::max(CylinderSd(p, 1, orbit, 14), 30.0 - p[1]));
+    }
+    const double small[3] = { 0, 0, -20 };
+    sd = std::max(sd, -CylinderSd(p, 0, small, 5));
+    const double hu = 1100 + 250 * std::sin(0.045 * p[0] + 0.5) * std::cos(0.035 * p[1]) +
+      150 * std::sin(0.06 * p[2]);
+    Mix(v, hu, Inside(sd, ramp));
+  }
+
+  // Separate bones below the cranium. Mandible: the front half of a torus.
+  {
+    const double c[3] = { 0, 25, -75 };
+    const double ring = std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]));
+    double sd = std::sqrt((ring - 40) * (ring - 40) + (p[2] - c[2]) * (p[2] - c[2])) - 7;
+    sd = std::max(sd, 15.0 - p[1]);
+    if (sd < ramp)
+    {
+      Mix(v, 1200.0, Inside(sd, ramp));
+    }
+  }
+  // Three vertebrae (discs between them stay soft tissue).
+  for (int n = 0; n < 3; ++n)
+  {
+    const double c[3] = { 0, -20, -96.0 + 14.0 * n };
+    const double sd = std::max(CylinderSd(p, 2, c, 14), std::fabs(p[2] - c[2]) - 4.5);
+    if (sd < ramp)
+    {
+      Mix(v, 950.0, Inside(sd, ramp));
+    }
+  }
+  // A small fragment.
+  {
+    const double c[3] = { 50, -50, -45 }, r[3] = { 5, 5, 5 };
+    const double sd = EllipsoidSd(p, c, r);
+    if (sd < ramp)
+    {
+      Mix(v, 1000.0, Inside(sd, ramp));
+    }
+  }
+  return v;
+}
+
+//------------------------------------------------------------------------------
+int vtkRGPhantomSource::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  for (int a = 0; a < 3; ++a)
+  {
+    if (this->Dimensions[a] < 2)
+    {
+      vtkErrorMacro(<< "Dimensions must be at least 2 along each axis, not "
+                    << this->Dimensions[0] << " x " << this->Dimensions[1] << " x "
+                    << this->Dimensions[2] << ".");
+      return 0;
+    }
+  }
+  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
+    this->Dimensions[2] - 1 };
+  const double h = this->Spacing();
+  const double spacing[3] = { h, h, h };
+  double origin[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    origin[a] = -0.5 * (this->Dimensions[a] - 1) * h;
+  }
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
+  outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
+  outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
+  outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
+  vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_SHORT, 1);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo)
+{
+  vtkImageData* image = this->AllocateOutputData(output, outInfo);
+  vtkShortArray* hu = vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars());
+  if (!hu)
+  {
+    vtkErrorMacro(<< "Could not allocate the int16 output array.");
+    return;
+  }
+  hu->SetName("HU");
+  int ext[6];
+  image->GetExtent(ext);
+  double origin[3], spacing[3];
+  image->GetOrigin(origin);
+  image->GetSpacing(spacing);
+  const std::uint64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
+  short* out = hu->GetPointer(0);
+  for (int k = ext[4]; k <= ext[5]; ++k)
+  {
+    if (ext[5] > ext[4])
+    {
+      this->UpdateProgress(double(k - ext[4]) / (ext[5] - ext[4]));
+    }
+    if (this->CheckAbort())
+    {
+      break;
+    }
+    for (int j = ext[2]; j <= ext[3]; ++j)
+    {
+      for (int i = ext[0]; i <= ext[1]; ++i)
+      {
+        const double p[3] = { origin[0] + i * spacing[0], origin[1] + j * spacing[1],
+          origin[2] + k * spacing[2] };
+        double v = this->Evaluate(p);
+        if (this->NoiseLevel > 0)
+        {
+          v += this->NoiseLevel * Noise((std::uint64_t(k) * ny + j) * nx + i, this->RandomSeed);
+        }
+        *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3071.0, v))));
+      }
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkRGPhantomSource::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << " "
+     << this->Dimensions[2] << "\n";
+  os << indent << "FieldOfView: " << this->FieldOfView << "\n";
+  os << indent << "NoiseLevel: " << this->NoiseLevel << "\n";
+  os << indent << "RandomSeed: " << this->RandomSeed << "\n";
+}

@@ -1,0 +1,93 @@
+/**
+ * @class   vtkRGPhantomSource
+ * @brief   a deterministic CT-like head phantom in Hounsfield units, at any size
+ *
+ * vtkRGPhantomSource makes an int16 CT volume (array "HU") of a head-like phantom: air (-1000)
+ * around soft tissue (~40), a skull-like bone shell (700 to 1500 HU) with holes (foramen
+ * magnum, orbits, two small foramina), a brain (~35) with ventricles (~8) and eyes inside, and
+ * separate bone pieces below it (a U-shaped mandible, three vertebrae separated by discs, a small
+ * fragment), with mild noise. Boundaries are ramps about one voxel wide, as partial volume
+ * makes them in a real scanner.
+ *
+ * The field of view (default 240 mm) is centred on the origin; spacing is FieldOfView /
+ * Dimensions. Every sample depends only on its global index and RandomSeed, so any piece (the
+ * source produces sub-extents) is identical to the same region of the whole volume: ranks can
+ * generate their own pieces in parallel.
+ *
+ * World coordinates of useful seeds (mm): the top of the skull (0, 0, 105); the mandible
+ * (0, 65, -75); the lowest vertebra (0, -20, -96).
+ *
+ * @sa vtkRTAnalyticSource
+ */
+
+#ifndef vtkRGPhantomSource_h
+#define vtkRGPhantomSource_h
+
+#include "RGMCFiltersModule.h" // For export macro
+#include "vtkImageAlgorithm.h"
+
+class RGMCFILTERS_EXPORT vtkRGPhantomSource : public vtkImageAlgorithm
+{
+public:
+  static vtkRGPhantomSource* New();
+  vtkTypeMacro(vtkRGPhantomSource, vtkImageAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * Number of samples along x, y, z (default 128 each; at least 2).
+   */
+  vtkSetVector3Macro(Dimensions, int);
+  vtkGetVector3Macro(Dimensions, int);
+  ///@}
+
+  ///@{
+  /**
+   * Physical size of the volume along its longest axis in mm (default 240).
+   */
+  vtkSetClampMacro(FieldOfView, double, 1e-3, VTK_DOUBLE_MAX);
+  vtkGetMacro(FieldOfView, double);
+  ///@}
+
+  ///@{
+  /**
+   * Standard deviation of the noise in HU (default 12; 0 for a noiseless phantom).
+   */
+  vtkSetClampMacro(NoiseLevel, double, 0.0, 1000.0);
+  vtkGetMacro(NoiseLevel, double);
+  ///@}
+
+  ///@{
+  /**
+   * Seed of the noise (default 1).
+   */
+  vtkSetMacro(RandomSeed, int);
+  vtkGetMacro(RandomSeed, int);
+  ///@}
+
+  /**
+   * The phantom's value in HU at a world point (mm), without noise; exposed for tests.
+   */
+  double Evaluate(const double x[3]) const;
+
+protected:
+  vtkRGPhantomSource();
+  ~vtkRGPhantomSource() override = default;
+
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  void ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo) override;
+
+  int Dimensions[3] = { 128, 128, 128 };
+  double FieldOfView = 240.0;
+  double NoiseLevel = 12.0;
+  int RandomSeed = 1;
+
+private:
+  vtkRGPhantomSource(const vtkRGPhantomSource&) = delete;
+  void operator=(const vtkRGPhantomSource&) = delete;
+
+  double Spacing() const;
+  double Ramp() const;
+};
+
+#endif
