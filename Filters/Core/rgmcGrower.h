@@ -130,6 +130,10 @@ public:
   /// input lacked its ghost layer); such normals are one-sided.
   bool MissingGhosts() const { return this->GhostsMissing; }
   bool Stopped() const { return this->AbortFlag || !this->ErrorText.empty(); }
+  /// How often a vertex was met that another component had created. On a single owner growth
+  /// follows every adjacency, so this stays 0; across owners it joins components that meet
+  /// through cubes of another rank.
+  std::int64_t Joins() const { return this->JoinCount; }
 
   int Root(int c)
   {
@@ -713,6 +717,7 @@ private:
     {
       std::swap(a, b);
     }
+    ++this->JoinCount;
     Component& keep = this->Components[a];
     const Component& gone = this->Components[b];
     keep.Seeded = keep.Seeded || gone.Seeded;
@@ -1033,6 +1038,7 @@ private:
   KeyMap VertexIds{ 1 << 16 };
   std::vector<Node> Stack;
   std::int64_t NodesProcessed = 0;
+  std::int64_t JoinCount = 0;
   std::string ErrorText;
   bool AbortFlag = false;
   bool GhostsMissing = false;

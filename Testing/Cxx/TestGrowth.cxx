@@ -1,0 +1,341 @@
+// Unit test of the growth kernel on tiny volumes checked by hand, on a volume split between
+// owners (whose union must be the whole), and of its cost: seeded growth reads samples near the
+// surface only, so the same surface in a larger volume costs exactly the same reads.
+#include "rgmcCheck.h"
+#include "rgmcGrower.h"
+
+#include "vtkMarchingCubesTriangleCases.h"
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <vector>
+
+namespace
+{
+
+const rgmc::CaseTable& Table()
+{
+  static const rgmc::CaseTable table(&vtkMarchingCubesTriangleCases::GetCases()[0].edges[0]);
+  return table;
+}
+
+/// Samples that count how often they are read.
+struct Counted
+{
+  const std::vector<float>* Data;
+  mutable std::int64_t Reads = 0;
+  float operator[](std::int64_t i) const
+  {
+    ++this->Reads;
+    return (*this->Data)[static_cast<std::size_t>(i)];
+  }
+};
+
+struct Volume
+{
+  int Extent[6];
+  std::vector<float> Values;
+
+  Volume(int nx, int ny, int nz)
+    : Extent{ 0, nx - 1, 0, ny - 1, 0, nz - 1 }
+    , Values(static_cast<std::size_t>(nx) * ny * nz, 0.0f)
+  {
+  }
+  float& At(int i, int j, int k)
+  {
+    return this->Values[i + (this->Extent[1] + 1) * (j + (this->Extent[3] + 1) * k)];
+  }
+};
+
+rgmc::Ownership OwnAll(const rgmc::Grid& grid)
+{
+  return rgmc::Ownership({ grid.WholeCells() }, 0);
+}
+
+using Triangle = std::array<std::int64_t, 3>;
+
+std::set<Triangle> KeyTriangles(const rgmc::LocalMesh& mesh)
+{
+  std::set<Triangle> out;
+  for (std::int64_t t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    Triangle tri;
+    for (int v = 0; v < 3; ++v)
+    {
+      tri[v] = mesh.Keys[mesh.Triangles[3 * t + v]];
+    }
+    std::sort(tri.begin(), tri.end());
+    out.insert(tri);
+  }
+  return out;
+}
+
+/// Every edge of a closed surface is used by exactly two triangles.
+bool Closed(const std::set<Triangle>& tris)
+{
+  std::map<std::pair<std::int64_t, std::int64_t>, int> uses;
+  for (const Triangle& t : tris)
+  {
+    ++uses[{ t[0], t[1] }];
+    ++uses[{ t[1], t[2] }];
+    ++uses[{ t[0], t[2] }];
+  }
+  for (const auto& u : uses)
+  {
+    if (u.second != 2)
+    {
+      return false;
+    }
+  }
+  return !tris.empty();
+}
+
+void OneCorner()
+{
+  Volume vol(2, 2, 2);
+  vol.At(0, 0, 0) = 1.0f;
+  const rgmc::Grid grid(vol.Extent, vol.Extent);
+  const rgmc::Ownership own = OwnAll(grid);
+  rgmc::GrowerParams params;
+  params.Isovalue = 0.5;
+  const std::vector<float>& values = vol.Values;
+  rgmc::Grower<std::vector<float>> g(Table(), grid, own, values, params);
+  const int comp = g.GrowFromKey(grid.EdgeKey(0, 0, 0, 0));
+  RGMC_CHECK(comp == 0, "one component");
+  RGMC_CHECK(g.Mesh.NumberOfTriangles() == 1 && g.Mesh.NumberOfPoints() == 3, "one triangle");
+  RGMC_CHECK(g.Ports.empty(), "no ports on one rank");
+  // The vertex on the x edge: t = 0.5, at (0.5, 0, 0). Its normal interpolates the negative
+  // gradients (1, 1, 1) at (0,0,0) and (1, 0, 0) at (1,0,0) (one-sided at the border).
+  for (std::int64_t p = 0; p < g.Mesh.NumberOfPoints(); ++p)
+  {
+    int q[3], axis;
+    grid.Decode(g.Mesh.Keys[p], q, axis);
+    RGMC_CHECK(q[0] == 0 && q[1] == 0 && q[2] == 0 && axis >= 0, "vertex on an edge of corner 0");
+    double expected[3] = { 0, 0, 0 };
+    expected[axis] = 0.5;
+    for (int a = 0; a < 3; ++a)
+    {
+      RGMC_CHECK(g.Mesh.Points[3 * p + a] == expected[a], "position of vertex on axis " << axis);
+    }
+    double n[3] = { 0.5, 0.5, 0.5 };
+    n[axis] = 1.0;
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int a = 0; a < 3; ++a)
+    {
+      RGMC_CHECK(std::fabs(g.Mesh.Normals[3 * p + a] - n[a] / len) < 1e-6, "normal on axis " << axis);
+    }
+  }
+}
+
+void TwoBlobs()
+{
+  // Two single-voxel blobs: each gives a closed octahedron of 8 triangles.
+  Volume vol(7, 3, 3);
+  vol.At(1, 1, 1) = 1.0f;
+  vol.At(5, 1, 1) = 1.0f;
+  const rgmc::Grid grid(vol.Extent, vol.Extent);
+  const rgmc::Ownership own = OwnAll(grid);
+  rgmc::GrowerParams params;
+  params.Isovalue = 0.5;
+  {
+    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    g.GrowFromKey(grid.EdgeKey(4, 1, 1, 0)); // the edge from (4,1,1) to (5,1,1): blob 2
+    const std::set<Triangle> tris = KeyTriangles(g.Mesh);
+    RGMC_CHECK(tris.size() == 8 && Closed(tris), "seeded growth gives blob 2 only: " << tris.size());
+    for (std::int64_t p = 0; p < g.Mesh.NumberOfPoints(); ++p)
+    {
+      RGMC_CHECK(g.Mesh.Points[3 * p] > 3.0, "a vertex of blob 1 was extracted");
+    }
+  }
+  {
+    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    g.GrowAll();
+    int roots = 0;
+    for (int c = 0; c < static_cast<int>(g.Components.size()); ++c)
+    {
+      if (g.Root(c) == c)
+      {
+        ++roots;
+        RGMC_CHECK(g.Components[c].Triangles == 8, "each blob has 8 triangles");
+      }
+    }
+    RGMC_CHECK(roots == 2, "two components, not " << roots);
+  }
+}
+
+void SampleEqualsIsovalue()
+{
+  // A lone sample equal to the isovalue: every vertex collapses onto it, every triangle is
+  // dropped (vtkMarchingCubes drops them too: their points merge).
+  Volume vol(3, 3, 3);
+  vol.At(1, 1, 1) = 0.5f;
+  const rgmc::Grid grid(vol.Extent, vol.Extent);
+  const rgmc::Ownership own = OwnAll(grid);
+  rgmc::GrowerParams params;
+  params.Isovalue = 0.5;
+  rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+  g.GrowAll();
+  RGMC_CHECK(g.Mesh.NumberOfTriangles() == 0, "collapsed triangles must be dropped");
+
+  // A blob whose neighbour sample equals the isovalue: the vertices on that sample's edges are
+  // the grid point itself, shared by all its edges, and the surface stays closed.
+  Volume pinch(5, 3, 3);
+  pinch.At(1, 1, 1) = 1.0f;
+  pinch.At(2, 1, 1) = 0.5f;
+  const rgmc::Grid grid2(pinch.Extent, pinch.Extent);
+  const rgmc::Ownership own2 = OwnAll(grid2);
+  rgmc::Grower<std::vector<float>> h(Table(), grid2, own2, pinch.Values, params);
+  h.GrowAll();
+  const std::set<Triangle> tris = KeyTriangles(h.Mesh);
+  int pointKeys = 0;
+  for (std::int64_t key : h.Mesh.Keys)
+  {
+    pointKeys += grid2.IsPointKey(key);
+  }
+  RGMC_CHECK(pointKeys == 1, "exactly one grid-point vertex, at (2,1,1): " << pointKeys);
+  RGMC_CHECK(Closed(tris), "the pinched blob is closed");
+}
+
+/// A smooth field with several blobs, split between two owners along x.
+void SplitOwnership()
+{
+  Volume vol(12, 9, 8);
+  for (int k = 0; k <= 7; ++k)
+  {
+    for (int j = 0; j <= 8; ++j)
+    {
+      for (int i = 0; i <= 11; ++i)
+      {
+        vol.At(i, j, k) = static_cast<float>(std::sin(0.9 * i) * std::cos(0.7 * j) + 0.3 * std::sin(1.3 * k));
+      }
+    }
+  }
+  const rgmc::Grid grid(vol.Extent, vol.Extent);
+  rgmc::GrowerParams params;
+  params.Isovalue = 0.2;
+  const rgmc::Ownership one = OwnAll(grid);
+  rgmc::Grower<std::vector<float>> whole(Table(), grid, one, vol.Values, params);
+  whole.GrowAll();
+  const std::set<Triangle> expected = KeyTriangles(whole.Mesh);
+
+  std::vector<rgmc::CellBox> boxes(2, grid.WholeCells());
+  boxes[0].Hi[0] = 4;
+  boxes[1].Lo[0] = 5;
+  std::set<Triangle> united;
+  std::map<std::int64_t, int> portSides;
+  for (int r = 0; r < 2; ++r)
+  {
+    const rgmc::Ownership own(boxes, r);
+    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    g.GrowAll();
+    for (const Triangle& t : KeyTriangles(g.Mesh))
+    {
+      RGMC_CHECK(united.insert(t).second, "a triangle was extracted by both owners");
+    }
+    for (const rgmc::Port& p : g.Ports)
+    {
+      int q[3], axis;
+      grid.Decode(p.Key, q, axis);
+      RGMC_CHECK(q[0] == 5, "ports lie on the plane between the owners, not at x = " << q[0]);
+      portSides[p.Key] |= 1 << r;
+    }
+  }
+  RGMC_CHECK(united == expected, "the owners' union differs from the whole: " << united.size()
+                                                                             << " vs " << expected.size());
+  for (const auto& p : portSides)
+  {
+    RGMC_CHECK(p.second == 3, "port " << p.first << " seen by one owner only");
+  }
+  RGMC_CHECK(!portSides.empty(), "the surface crosses the plane, so there are ports");
+}
+
+/// Seeded growth reads the same samples for the same surface, however large the volume.
+void CostFollowsSurface()
+{
+  std::int64_t reads[2] = { 0, 0 };
+  std::size_t triangles[2] = { 0, 0 };
+  const int sizes[2] = { 24, 96 };
+  for (int n = 0; n < 2; ++n)
+  {
+    const int size = sizes[n];
+    Volume vol(size, size, size);
+    for (int k = 0; k < size; ++k)
+    {
+      for (int j = 0; j < size; ++j)
+      {
+        for (int i = 0; i < size; ++i)
+        {
+          const double d = std::sqrt((i - 10.3) * (i - 10.3) + (j - 10.7) * (j - 10.7) +
+            (k - 10.1) * (k - 10.1));
+          vol.At(i, j, k) = static_cast<float>(6.0 - d);
+        }
+      }
+    }
+    const rgmc::Grid grid(vol.Extent, vol.Extent);
+    const rgmc::Ownership own = OwnAll(grid);
+    rgmc::GrowerParams params;
+    Counted counted{ &vol.Values };
+    rgmc::Grower<Counted> g(Table(), grid, own, counted, params);
+    const double seed[3] = { 16.5, 10.5, 10.5 };
+    const rgmc::SeedHit hit = g.NearestVertex(seed, seed, 10.0, 1.0);
+    RGMC_CHECK(hit.Found, "the sphere is within the radius");
+    g.GrowFromKey(hit.Key);
+    reads[n] = counted.Reads;
+    triangles[n] = static_cast<std::size_t>(g.Mesh.NumberOfTriangles());
+    RGMC_CHECK(Closed(KeyTriangles(g.Mesh)), "the sphere is closed");
+  }
+  RGMC_CHECK(triangles[0] == triangles[1] && triangles[0] > 0, "same sphere, same triangles");
+  RGMC_CHECK(reads[0] == reads[1], "reads grew with the volume: " << reads[0] << " vs " << reads[1]);
+  // 24^3 has 12167 cubes; the growth must stay well below one read per sample of the volume.
+  RGMC_CHECK(reads[1] < 96LL * 96 * 96 / 20, "reads " << reads[1] << " look like a full scan");
+}
+
+/// On one owner, growth follows every adjacency by itself: a component never meets a vertex
+/// that another component created. Checked on many small volumes whose samples often equal
+/// the isovalue (where vertices collapse and surfaces touch only at points).
+void TraversalIsComplete()
+{
+  std::uint64_t state = 88172645463325252ull;
+  auto next = [&state]() {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return static_cast<double>(state % 1000000) / 1000000.0;
+  };
+  std::int64_t joins = 0, triangles = 0;
+  for (int trial = 0; trial < 400; ++trial)
+  {
+    const double pOne = 0.1 + 0.3 * next(), pTwo = 0.05 + 0.3 * next();
+    Volume vol(7, 6, 7);
+    for (float& v : vol.Values)
+    {
+      const double r = next();
+      v = r < pTwo ? 2.0f : (r < pTwo + pOne ? 1.0f : 0.0f);
+    }
+    const rgmc::Grid grid(vol.Extent, vol.Extent);
+    const rgmc::Ownership own = OwnAll(grid);
+    rgmc::GrowerParams params;
+    params.Isovalue = 1.0;
+    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    g.GrowAll();
+    joins += g.Joins();
+    triangles += g.Mesh.NumberOfTriangles();
+  }
+  RGMC_CHECK(triangles > 0, "the volumes have surfaces");
+  RGMC_CHECK(joins == 0, "growth missed " << joins << " adjacencies that a later component met");
+}
+
+} // namespace
+
+int main()
+{
+  OneCorner();
+  TwoBlobs();
+  SampleEqualsIsovalue();
+  SplitOwnership();
+  CostFollowsSurface();
+  TraversalIsComplete();
+  return rgmc_test::Result("TestGrowth");
+}

@@ -1,0 +1,81 @@
+// Unit test of vertex keys and ownership: keys are unique, decodable, independent of the piece
+// a rank holds, and every cube has exactly one owner.
+#include "rgmcCheck.h"
+#include "rgmcGrid.h"
+
+#include <set>
+
+int main()
+{
+  const int whole[6] = { -2, 3, 1, 4, 5, 7 }; // a whole extent that does not start at 0
+  const int pieceA[6] = { -2, 1, 1, 4, 5, 7 };
+  const int pieceB[6] = { 0, 3, 2, 4, 5, 6 };
+  const rgmc::Grid full(whole, whole), a(whole, pieceA), b(whole, pieceB);
+
+  std::set<std::int64_t> keys;
+  for (int k = whole[4]; k <= whole[5]; ++k)
+  {
+    for (int j = whole[2]; j <= whole[3]; ++j)
+    {
+      for (int i = whole[0]; i <= whole[1]; ++i)
+      {
+        for (int axis = -1; axis < 3; ++axis)
+        {
+          const std::int64_t key =
+            axis < 0 ? full.PointKey(i, j, k) : full.EdgeKey(i, j, k, axis);
+          RGMC_CHECK(keys.insert(key).second, "duplicate key at " << i << " " << j << " " << k);
+          RGMC_CHECK(full.IsPointKey(key) == (axis < 0), "key kind at " << i << " " << j << " " << k);
+          int p[3], decodedAxis;
+          full.Decode(key, p, decodedAxis);
+          RGMC_CHECK(p[0] == i && p[1] == j && p[2] == k && decodedAxis == axis,
+            "decode of " << key);
+          // The key depends on the whole extent only, not on the piece.
+          const std::int64_t ka = axis < 0 ? a.PointKey(i, j, k) : a.EdgeKey(i, j, k, axis);
+          const std::int64_t kb = axis < 0 ? b.PointKey(i, j, k) : b.EdgeKey(i, j, k, axis);
+          RGMC_CHECK(ka == key && kb == key, "piece-dependent key at " << i << " " << j << " " << k);
+        }
+      }
+    }
+  }
+  RGMC_CHECK(static_cast<std::int64_t>(keys.size()) == 4 * full.NumPoints, "key count");
+
+  // Local indices follow the piece's layout.
+  RGMC_CHECK(b.LocalIndex(0, 2, 5) == 0, "first sample of piece B");
+  RGMC_CHECK(b.LocalIndex(3, 4, 6) == 4 * 3 * 2 - 1, "last sample of piece B");
+
+  // Ownership: overlapping boxes go to the lowest rank; every whole cell has one owner.
+  std::vector<rgmc::CellBox> boxes(3);
+  boxes[0].Lo[0] = -2, boxes[0].Hi[0] = 0, boxes[0].Lo[1] = 1, boxes[0].Hi[1] = 3;
+  boxes[0].Lo[2] = 5, boxes[0].Hi[2] = 6;
+  boxes[1] = full.WholeCells(); // a reader that ignored the piece request
+  boxes[2] = rgmc::CellBox();   // a rank with no data
+  std::vector<rgmc::Ownership> owners;
+  for (int r = 0; r < 3; ++r)
+  {
+    owners.emplace_back(boxes, r);
+  }
+  RGMC_CHECK(owners[2].OwnsNothing(), "the empty rank owns nothing");
+  RGMC_CHECK(!owners[1].OwnsNothing(), "rank 1 owns what rank 0 lacks");
+  const rgmc::CellBox cells = full.WholeCells();
+  for (int k = cells.Lo[2]; k <= cells.Hi[2]; ++k)
+  {
+    for (int j = cells.Lo[1]; j <= cells.Hi[1]; ++j)
+    {
+      for (int i = cells.Lo[0]; i <= cells.Hi[0]; ++i)
+      {
+        int count = 0, who = -1;
+        for (int r = 0; r < 3; ++r)
+        {
+          if (owners[r].Owns(i, j, k))
+          {
+            ++count;
+            who = r;
+          }
+        }
+        RGMC_CHECK(count == 1, "cell " << i << " " << j << " " << k << " has " << count << " owners");
+        RGMC_CHECK(owners[0].Owner(i, j, k) == who, "Owner() of " << i << " " << j << " " << k);
+      }
+    }
+  }
+  return rgmc_test::Result("TestVertexKeys");
+}
