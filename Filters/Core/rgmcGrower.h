@@ -373,8 +373,8 @@ private:
     {
       std::ostringstream msg;
       msg << "the scalar value at grid point (" << i << ", " << j << ", " << k
-          << ") is NaN; replace NaN samples (for example with the Threshold or Calculator "
-             "filter) before extracting a surface";
+          << ") is NaN; replace NaN samples before extracting a surface (for example with "
+             "the Python Calculator and numpy.nan_to_num)";
       this->ErrorText = msg.str();
     }
   }
