@@ -31,6 +31,7 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkTypeInt32Array.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
@@ -335,6 +336,7 @@ public:
   virtual int GrowFromKey(std::int64_t key) = 0;
   virtual void GrowAll() = 0;
   virtual void GrowBoundary() = 0;
+  virtual void Extract() = 0;
   virtual int Root(int c) = 0;
   virtual rgmc::LocalMesh& Mesh() = 0;
   virtual std::vector<rgmc::Component>& Components() = 0;
@@ -362,6 +364,7 @@ public:
   int GrowFromKey(std::int64_t key) override { return this->G.GrowFromKey(key); }
   void GrowAll() override { this->G.GrowAll(); }
   void GrowBoundary() override { this->G.GrowBoundary(); }
+  void Extract() override { this->G.Extract(); }
   int Root(int c) override { return this->G.Root(c); }
   rgmc::LocalMesh& Mesh() override { return this->G.Mesh; }
   std::vector<rgmc::Component>& Components() override { return this->G.Components; }
@@ -851,6 +854,7 @@ int vtkRGMarchingCubes::RequestData(
   rgmc::GrowerParams params;
   params.Isovalue = this->Isovalue;
   params.ComputeNormals = this->ComputeNormals;
+  params.DoublePoints = this->OutputPointsPrecision == DOUBLE_PRECISION;
   geom.IndexToWorldMatrix(params.IndexToWorld);
   geom.NormalMatrix(params.NormalToWorld);
   params.Progress = [this](double fraction) {
@@ -990,11 +994,7 @@ int vtkRGMarchingCubes::RequestData(
   {
     for (vtkIdType key : seedKeys)
     {
-      const int comp = grower.GrowFromKey(key);
-      if (comp >= 0)
-      {
-        grower.Components()[grower.Root(comp)].Seeded = true;
-      }
+      grower.GrowFromKey(key); // seeded components; before the boundary growth
     }
     if (ranks.Size > 1)
     {
@@ -1005,6 +1005,7 @@ int vtkRGMarchingCubes::RequestData(
   {
     grower.GrowAll();
   }
+  grower.Extract();
   {
     std::string error = grower.Error();
     if (!ranks.Agree(error.empty(), error))
@@ -1030,82 +1031,64 @@ int vtkRGMarchingCubes::RequestData(
   const Decision decision = Resolve(ranks, grower, grid, own, this->ExtractionMode, rootIndex);
   this->UpdateProgress(0.9);
 
-  // PASS 5: the output piece.
-  const rgmc::LocalMesh& mesh = grower.Mesh();
-  const vtkIdType numTris = mesh.NumberOfTriangles();
-  std::vector<vtkIdType> pointMap(static_cast<std::size_t>(mesh.NumberOfPoints()), -1);
-  std::vector<vtkIdType> keptTris;
-  keptTris.reserve(static_cast<std::size_t>(numTris));
-  for (vtkIdType t = 0; t < numTris; ++t)
+  // PASS 5: the output piece. The kernel's buffers become the output arrays without copies.
+  rgmc::LocalMesh& mesh = grower.Mesh();
+  mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
+  const vtkIdType numPoints = mesh.NumberOfPoints();
+  const vtkIdType numKept = mesh.NumberOfTriangles();
+  for (std::int32_t& comp : mesh.TriangleComponent)
   {
-    if (decision.FinalId[rootIndex[mesh.TriangleComponent[t]]] >= 0)
-    {
-      keptTris.push_back(t);
-      for (int v = 0; v < 3; ++v)
-      {
-        pointMap[mesh.Triangles[3 * t + v]] = 0;
-      }
-    }
-  }
-  vtkIdType numPoints = 0;
-  for (vtkIdType& id : pointMap)
-  {
-    if (id == 0)
-    {
-      id = numPoints++;
-    }
+    comp = static_cast<std::int32_t>(decision.FinalId[rootIndex[comp]]);
   }
 
   vtkNew<vtkPoints> points;
-  points->SetDataType(
-    this->OutputPointsPrecision == DOUBLE_PRECISION ? VTK_DOUBLE : VTK_FLOAT);
-  points->SetNumberOfPoints(numPoints);
+  if (this->OutputPointsPrecision == DOUBLE_PRECISION)
+  {
+    vtkNew<vtkDoubleArray> xyz;
+    xyz->SetNumberOfComponents(3);
+    xyz->SetArray(mesh.PointsDouble.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+    points->SetData(xyz);
+  }
+  else
+  {
+    vtkNew<vtkFloatArray> xyz;
+    xyz->SetNumberOfComponents(3);
+    xyz->SetArray(mesh.Points.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+    points->SetData(xyz);
+  }
   vtkNew<vtkFloatArray> normals;
   normals->SetName("Normals");
   normals->SetNumberOfComponents(3);
-  normals->SetNumberOfTuples(this->ComputeNormals ? numPoints : 0);
+  if (this->ComputeNormals)
+  {
+    normals->SetArray(mesh.Normals.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+  }
   vtkNew<vtkIdTypeArray> keys;
   keys->SetName("VertexKey");
-  keys->SetNumberOfTuples(numPoints);
-  for (vtkIdType p = 0; p < mesh.NumberOfPoints(); ++p)
-  {
-    const vtkIdType id = pointMap[p];
-    if (id < 0)
-    {
-      continue;
-    }
-    points->SetPoint(id, &mesh.Points[3 * p]);
-    if (this->ComputeNormals)
-    {
-      normals->SetTypedTuple(id, &mesh.Normals[3 * p]);
-    }
-    keys->SetValue(id, mesh.Keys[p]);
-  }
+  static_assert(sizeof(vtkIdType) == sizeof(long long), "vertex keys are 64-bit ids");
+  keys->SetArray(reinterpret_cast<vtkIdType*>(mesh.Keys.Release()), numPoints, 0,
+    vtkAbstractArray::VTK_DATA_ARRAY_FREE);
 
-  const vtkIdType numKept = static_cast<vtkIdType>(keptTris.size());
-  vtkNew<vtkIdTypeArray> offsets, connectivity;
+  // Triangles: 32-bit connectivity, adopted as is.
+  vtkNew<vtkTypeInt32Array> offsets, connectivity;
   offsets->SetNumberOfTuples(numKept + 1);
-  connectivity->SetNumberOfTuples(3 * numKept);
-  vtkNew<vtkIntArray> rankIds, componentIds;
-  rankIds->SetName("RankId");
-  rankIds->SetNumberOfTuples(numKept);
-  componentIds->SetName("ComponentId");
-  componentIds->SetNumberOfTuples(numKept);
-  for (vtkIdType n = 0; n < numKept; ++n)
+  std::int32_t* o = offsets->GetPointer(0);
+  for (vtkIdType n = 0; n <= numKept; ++n)
   {
-    const vtkIdType t = keptTris[n];
-    offsets->SetValue(n, 3 * n);
-    for (int v = 0; v < 3; ++v)
-    {
-      connectivity->SetValue(3 * n + v, pointMap[mesh.Triangles[3 * t + v]]);
-    }
-    rankIds->SetValue(n, ranks.Rank);
-    componentIds->SetValue(
-      n, static_cast<int>(decision.FinalId[rootIndex[mesh.TriangleComponent[t]]]));
+    o[n] = static_cast<std::int32_t>(3 * n);
   }
-  offsets->SetValue(numKept, 3 * numKept);
+  connectivity->SetArray(mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
   vtkNew<vtkCellArray> polys;
   polys->SetData(offsets, connectivity);
+  vtkNew<vtkIntArray> componentIds;
+  componentIds->SetName("ComponentId");
+  static_assert(sizeof(int) == sizeof(std::int32_t), "component ids are 32-bit");
+  componentIds->SetArray(reinterpret_cast<int*>(mesh.TriangleComponent.Release()), numKept, 0,
+    vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+  vtkNew<vtkIntArray> rankIds;
+  rankIds->SetName("RankId");
+  rankIds->SetNumberOfTuples(numKept);
+  rankIds->FillValue(ranks.Rank);
 
   output->Initialize();
   output->SetPoints(points);

@@ -7,16 +7,24 @@
 // point), so it reproduces exactly the connectivity of vtkMarchingCubes followed by
 // vtkPolyDataConnectivityFilter while touching only cubes the surface passes through.
 //
-// Each node is grown into a local component. Components that meet through a vertex this piece
-// cannot see whole (a cube around it belongs to another rank) record that vertex as a port; the
-// VTK layer matches ports across ranks and joins the components (vtkRGMarchingCubes).
+// Two phases. Growth (GrowFromKey, GrowAll, GrowBoundary) only finds the nodes: a breadth-first
+// search over a bit per cube, appending each node and its component to a list that is also the
+// queue. Extraction (Extract) then makes the triangles slab by slab along z, so that vertices
+// shared by neighbouring cubes are found in small per-slab edge tables instead of a hash over
+// the whole surface.
+//
+// Components that meet through a vertex this piece cannot see whole (a cube around it belongs to
+// another rank) record that vertex as a port; the VTK layer matches ports across ranks and joins
+// the components (vtkRGMarchingCubes).
 #ifndef rgmcGrower_h
 #define rgmcGrower_h
 
+#include "rgmcBuffer.h"
 #include "rgmcCaseTable.h"
 #include "rgmcGrid.h"
 #include "rgmcKeyMap.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -33,12 +41,15 @@ struct GrowerParams
 {
   double Isovalue = 0.0;
   bool ComputeNormals = true;
+  /// Store output points in double (LocalMesh::PointsDouble) instead of float (Points).
+  bool DoublePoints = false;
   /// world = IndexToWorld * (i, j, k, 1): direction * spacing, then origin.
   double IndexToWorld[3][4] = { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 } };
   /// Maps an index-space gradient to a world-space normal before normalizing:
   /// det(direction) * direction * diag(1 / spacing), as vtkImageTransform does.
   double NormalToWorld[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
-  /// Called every few thousand nodes with a rough fraction done; returns true to abort.
+  /// Called now and then with the fraction done (growth fills the first half, extraction the
+  /// second; never decreasing); returns true to abort.
   std::function<bool(double)> Progress;
 };
 
@@ -67,21 +78,92 @@ struct SeedHit
   double Point[3] = { 0, 0, 0 };
 };
 
-/// What one piece produced: vertices (world coordinates in double, normals), triangles over
-/// them, and the local component of each triangle.
+/// What one piece produced: vertices (positions, computed in double and stored in the
+/// requested precision; normals; keys), triangles over them, and the local component of each
+/// triangle. The buffers can be handed over to VTK arrays without copying.
 struct LocalMesh
 {
-  std::vector<double> Points;
-  std::vector<float> Normals;
-  std::vector<std::int64_t> Keys;
-  std::vector<std::int32_t> VertexComponent;
-  std::vector<std::int32_t> Triangles;
-  std::vector<std::int32_t> TriangleComponent;
+  Buffer<float> Points;
+  Buffer<double> PointsDouble;
+  Buffer<float> Normals;
+  Buffer<long long> Keys;
+  Buffer<std::int32_t> VertexComponent;
+  Buffer<std::int32_t> Triangles;
+  Buffer<std::int32_t> TriangleComponent;
 
   std::int64_t NumberOfPoints() const { return static_cast<std::int64_t>(this->Keys.size()); }
   std::int64_t NumberOfTriangles() const
   {
     return static_cast<std::int64_t>(this->TriangleComponent.size());
+  }
+  void GetPoint(std::int64_t p, double x[3]) const
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      x[a] = this->PointsDouble.empty() ? this->Points[3 * p + a] : this->PointsDouble[3 * p + a];
+    }
+  }
+
+  /// Keeps the triangles whose component `keep(component)` accepts and the points they use,
+  /// in their order, in place.
+  template <typename Keep>
+  void Compact(Keep&& keep)
+  {
+    const std::int64_t numPoints = this->NumberOfPoints();
+    std::vector<std::int32_t> newId(static_cast<std::size_t>(numPoints), -1);
+    std::size_t kept = 0;
+    for (std::size_t t = 0; t < this->TriangleComponent.size(); ++t)
+    {
+      if (keep(this->TriangleComponent[t]))
+      {
+        for (int v = 0; v < 3; ++v)
+        {
+          this->Triangles[3 * kept + v] = this->Triangles[3 * t + v];
+          newId[this->Triangles[3 * t + v]] = 0;
+        }
+        this->TriangleComponent[kept++] = this->TriangleComponent[t];
+      }
+    }
+    this->Triangles.resize_down(3 * kept);
+    this->TriangleComponent.resize_down(kept);
+    std::int32_t next = 0;
+    for (std::int64_t p = 0; p < numPoints; ++p)
+    {
+      if (newId[p] < 0)
+      {
+        continue;
+      }
+      newId[p] = next;
+      for (int a = 0; a < 3; ++a)
+      {
+        if (!this->Points.empty())
+        {
+          this->Points[3 * next + a] = this->Points[3 * p + a];
+        }
+        if (!this->PointsDouble.empty())
+        {
+          this->PointsDouble[3 * next + a] = this->PointsDouble[3 * p + a];
+        }
+        if (!this->Normals.empty())
+        {
+          this->Normals[3 * next + a] = this->Normals[3 * p + a];
+        }
+      }
+      this->Keys[next] = this->Keys[p];
+      this->VertexComponent[next] = this->VertexComponent[p];
+      ++next;
+    }
+    for (std::int32_t& id : this->Triangles)
+    {
+      id = newId[id];
+    }
+    for (auto* buffer : { &this->Points, &this->Normals })
+    {
+      buffer->resize_down(buffer->empty() ? 0 : 3 * static_cast<std::size_t>(next));
+    }
+    this->PointsDouble.resize_down(this->PointsDouble.empty() ? 0 : 3 * static_cast<std::size_t>(next));
+    this->Keys.resize_down(next);
+    this->VertexComponent.resize_down(next);
   }
 };
 
@@ -116,6 +198,25 @@ public:
     {
       this->EdgeAxisOf[e] = CaseTable::EdgeAxis(e);
     }
+    for (int a = 0; a < 3; ++a)
+    {
+      // Grid points where the gradient is central on every axis with samples at hand.
+      this->CentralLo[a] = std::max(this->G.WholeLo[a], this->G.LocalLo[a]) + 1;
+      this->CentralHi[a] = std::min(this->G.WholeHi[a], this->G.LocalHi[a]) - 1;
+      // Grid points all of whose surrounding cubes this rank owns (no ports there).
+      this->InnerLo[a] = box.Lo[a] + 1;
+      this->InnerHi[a] = box.Hi[a];
+    }
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      for (int du = 0; du < 2; ++du)
+      {
+        for (int dv = 0; dv < 2; ++dv)
+        {
+          this->EdgeAt[axis][du][dv] = CaseTable::EdgeAt(axis, du, dv);
+        }
+      }
+    }
   }
 
   // ---- results -------------------------------------------------------------------------------
@@ -130,10 +231,12 @@ public:
   /// input lacked its ghost layer); such normals are one-sided.
   bool MissingGhosts() const { return this->GhostsMissing; }
   bool Stopped() const { return this->AbortFlag || !this->ErrorText.empty(); }
-  /// How often a vertex was met that another component had created. On a single owner growth
-  /// follows every adjacency, so this stays 0; across owners it joins components that meet
-  /// through cubes of another rank.
+  /// How often extraction met a vertex that another component had created. On a single owner
+  /// growth follows every adjacency, so this stays 0; across owners it joins components that
+  /// meet through cubes of another rank.
   std::int64_t Joins() const { return this->JoinCount; }
+  /// Surface nodes found so far.
+  std::int64_t NumberOfNodes() const { return static_cast<std::int64_t>(this->Nodes.size()); }
 
   int Root(int c)
   {
@@ -146,16 +249,8 @@ public:
     return c;
   }
 
-  int AddComponent(bool seeded)
-  {
-    Component comp;
-    comp.Parent = static_cast<int>(this->Components.size());
-    comp.Seeded = seeded;
-    this->Components.push_back(comp);
-    return comp.Parent;
-  }
-
   // ---- seed search ---------------------------------------------------------------------------
+
   /// The surface vertex nearest to a seed among the cubes this piece owns, ties broken by the
   /// smaller key. `seedIndex` is the seed in continuous index coordinates (inside the volume),
   /// `seedWorld` the same point in world coordinates. Only vertices within `radius` count.
@@ -184,9 +279,7 @@ public:
         best.Found = true;
         best.Distance2 = d2;
         best.Key = key;
-        best.Point[0] = x[0];
-        best.Point[1] = x[1];
-        best.Point[2] = x[2];
+        std::copy(x, x + 3, best.Point);
       }
     };
 
@@ -213,40 +306,34 @@ public:
       if (!clip.Empty())
       {
         this->ForShell(clip, c, r, [&](int i, int j, int k) {
-          if (this->Stopped() || !this->Own.Owns(i, j, k) || !this->Evaluate(i, j, k, st))
-          {
-            return;
-          }
-          if (st.Case == 0 || st.Case == 255)
+          if (this->Stopped() || !this->Own.Owns(i, j, k) || !this->Evaluate(i, j, k, st) ||
+            st.Case == 0 || st.Case == 255)
           {
             return;
           }
           double x[3];
           if (!st.Degenerate)
           {
-            const CaseEntry& ce = this->Table[st.Case];
-            for (int e = 0; e < 12; ++e)
+            unsigned edges = this->Table[st.Case].CutEdges;
+            while (edges)
             {
-              if (ce.CutEdges & (1u << e))
-              {
-                int p[3];
-                this->EdgeLowPoint(i, j, k, e, p);
-                this->EdgePosition(p, this->EdgeAxisOf[e], st.S[EdgeCorners[e][0]],
-                  st.S[EdgeCorners[e][1]], x);
-                consider(this->G.EdgeKey(p[0], p[1], p[2], this->EdgeAxisOf[e]), x);
-              }
+              const int e = __builtin_ctz(edges);
+              edges &= edges - 1;
+              int p[3];
+              this->EdgeLowPoint(i, j, k, e, p);
+              this->EdgePosition(p, this->EdgeAxisOf[e], st.S[EdgeCorners[e][0]],
+                st.S[EdgeCorners[e][1]], x);
+              consider(this->G.EdgeKey(p[0], p[1], p[2], this->EdgeAxisOf[e]), x);
             }
+            return;
           }
-          else
+          this->ComputeGroups(i, j, k, st, groups);
+          for (int t = 0; t < groups.NumTriangles; ++t)
           {
-            this->ComputeGroups(i, j, k, st, groups);
-            for (int t = 0; t < groups.NumTriangles; ++t)
+            for (int v = 0; v < 3; ++v)
             {
-              for (int v = 0; v < 3; ++v)
-              {
-                this->KeyPosition(groups.Keys[t][v], st, i, j, k, groups.Edges[t][v], x);
-                consider(groups.Keys[t][v], x);
-              }
+              this->KeyPosition(groups.Keys[t][v], groups.Edges[t][v], st, x);
+              consider(groups.Keys[t][v], x);
             }
           }
         });
@@ -259,32 +346,30 @@ public:
     return best;
   }
 
-  // ---- growth --------------------------------------------------------------------------------
+  // ---- phase 1: growth -----------------------------------------------------------------------
 
-  /// Grows the component that contains the vertex `key` from the nodes of this piece that use
-  /// it. Returns that component (a new one, or the one that already holds the vertex), or -1
-  /// when no cube this piece owns has the vertex.
+  /// Grows, as a new seeded component, the component that contains the vertex `key`, from the
+  /// nodes of this piece that use it. Returns the new component; -1 when no cube this piece owns
+  /// has the vertex; -2 when its nodes were already found (by an earlier seed: seeds must be
+  /// grown before GrowBoundary).
   int GrowFromKey(std::int64_t key)
   {
-    if (const std::int32_t* existing = this->VertexIds.Find(key))
-    {
-      return this->Root(this->Mesh.VertexComponent[*existing]);
-    }
-    const int comp = this->AddComponent(false);
-    const std::size_t before = this->Stack.size();
+    const int comp = this->AddComponent(true);
+    const std::size_t before = this->Nodes.size();
     int p[3], axis;
     this->G.Decode(key, p, axis);
-    this->VisitAroundKey(key, p, axis, nullptr);
-    if (this->Stack.size() == before)
+    bool seen = false;
+    this->VisitAroundKey(key, p, axis, nullptr, comp, &seen);
+    if (this->Nodes.size() == before)
     {
       this->Components.pop_back();
-      return -1;
+      return seen ? -2 : -1;
     }
-    this->Drain(comp);
-    return this->Root(comp);
+    this->Drain(before);
+    return comp;
   }
 
-  /// Labels every component that has a node in an owned cube (a full scan: the "All" and
+  /// Finds every component that has a node in an owned cube (a full scan: the "All" and
   /// "Largest" modes).
   void GrowAll()
   {
@@ -325,6 +410,100 @@ public:
     }
   }
 
+  // ---- phase 2: extraction -------------------------------------------------------------------
+
+  /// Makes the triangles of every node found, slab by slab along z; fills Mesh, Ports and the
+  /// components' triangle counts and smallest keys.
+  void Extract()
+  {
+    if (this->Nodes.empty() || this->Stopped())
+    {
+      return;
+    }
+    const CellBox& box = this->Own.Mine();
+    const int numSlabs = box.Hi[2] - box.Lo[2] + 1;
+
+    // Nodes by slab (a counting sort on k).
+    std::vector<std::int64_t> start(static_cast<std::size_t>(numSlabs) + 1, 0);
+    std::int64_t triangles = 0;
+    for (const Node& n : this->Nodes)
+    {
+      ++start[n.K - box.Lo[2] + 1];
+      triangles += this->Table[n.Case].NumTriangles;
+    }
+    for (int s = 0; s < numSlabs; ++s)
+    {
+      start[s + 1] += start[s];
+    }
+    {
+      // Reorder the nodes by slab, so that extraction reads them in sequence.
+      std::vector<std::int64_t> next(start.begin(), start.end() - 1);
+      std::vector<Node> sorted(this->Nodes.size());
+      for (const Node& n : this->Nodes)
+      {
+        sorted[next[n.K - box.Lo[2]]++] = n;
+      }
+      this->Nodes.swap(sorted);
+    }
+    // A node emits at most its case's triangles; a closed surface has about half as many
+    // vertices as triangles.
+    LocalMesh& m = this->Mesh;
+    const std::size_t vertices = static_cast<std::size_t>(triangles / 2 + 64);
+    m.Triangles.reserve(static_cast<std::size_t>(3 * triangles));
+    m.TriangleComponent.reserve(static_cast<std::size_t>(triangles));
+    m.Keys.reserve(vertices);
+    m.VertexComponent.reserve(vertices);
+    if (this->P.DoublePoints)
+    {
+      m.PointsDouble.reserve(3 * vertices);
+    }
+    else
+    {
+      m.Points.reserve(3 * vertices);
+    }
+    if (this->P.ComputeNormals)
+    {
+      m.Normals.reserve(3 * vertices);
+    }
+
+    // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,
+    // z edges inside it. The top plane becomes the next slab's bottom.
+    this->LayerNx = this->BoxNx + 1;
+    const std::size_t planeSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
+    for (auto& layer : this->Layers)
+    {
+      layer.Ids.assign(planeSize, -1);
+      layer.Touched.clear();
+    }
+    Layer* bottom[2] = { &this->Layers[0], &this->Layers[1] }; // x, y edges at z = k
+    Layer* top[2] = { &this->Layers[2], &this->Layers[3] };    // x, y edges at z = k + 1
+    Layer* vertical = &this->Layers[4];                          // z edges
+    for (int s = 0; s < numSlabs && !this->Stopped(); ++s)
+    {
+      const int k = box.Lo[2] + s;
+      this->Slab[0][0] = bottom[0];
+      this->Slab[0][1] = bottom[1];
+      this->Slab[1][0] = top[0];
+      this->Slab[1][1] = top[1];
+      this->Vertical = vertical;
+      this->SlabK = k;
+      for (std::int64_t n = start[s]; n < start[s + 1] && !this->Stopped(); ++n)
+      {
+        this->Emit(this->Nodes[n]);
+      }
+      for (Layer* layer : { bottom[0], bottom[1], vertical })
+      {
+        layer->Reset();
+      }
+      std::swap(bottom[0], top[0]);
+      std::swap(bottom[1], top[1]);
+      if ((s & 15) == 0)
+      {
+        this->Report(0.5 + 0.5 * s / numSlabs);
+      }
+    }
+  }
+
 private:
   struct CubeState
   {
@@ -344,16 +523,54 @@ private:
     int Group[MaxTriangles];
   };
 
+  /// A node found by growth: its cube, case, group and component.
   struct Node
   {
-    int I, J, K;
-    int Group;
+    std::int32_t I, J, K;
+    std::int32_t Component;
+    std::uint8_t Case;
+    std::uint8_t Group;
+    bool Degenerate;
+  };
+
+  /// Vertex ids of one plane of edges, with the entries written so far (to reset cheaply).
+  struct Layer
+  {
+    std::vector<std::int32_t> Ids;
+    std::vector<std::int32_t> Touched;
+    void Reset()
+    {
+      for (std::int32_t t : this->Touched)
+      {
+        this->Ids[t] = -1;
+      }
+      this->Touched.clear();
+    }
   };
 
   static double Distance2(const double a[3], const double b[3])
   {
     const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
     return dx * dx + dy * dy + dz * dz;
+  }
+
+  /// Reports progress (never backwards) and notes an abort.
+  void Report(double fraction)
+  {
+    this->Reported = std::max(this->Reported, fraction);
+    if (this->P.Progress && this->P.Progress(this->Reported))
+    {
+      this->AbortFlag = true;
+    }
+  }
+
+  int AddComponent(bool seeded)
+  {
+    Component comp;
+    comp.Parent = static_cast<int>(this->Components.size());
+    comp.Seeded = seeded;
+    this->Components.push_back(comp);
+    return comp.Parent;
   }
 
   /// The sample at grid point (i, j, k) of this piece; a NaN stops the growth with an error.
@@ -481,10 +698,7 @@ private:
       }
     }
     int groupOfRoot[MaxTriangles];
-    for (int t = 0; t < g.NumTriangles; ++t)
-    {
-      groupOfRoot[t] = -1;
-    }
+    std::fill(groupOfRoot, groupOfRoot + MaxTriangles, -1);
     g.NumGroups = 0;
     for (int t = 0; t < g.NumTriangles; ++t)
     {
@@ -501,7 +715,8 @@ private:
   {
     for (int t = 0; t < g.NumTriangles; ++t)
     {
-      if (g.Group[t] == group && (g.Keys[t][0] == key || g.Keys[t][1] == key || g.Keys[t][2] == key))
+      if (g.Group[t] == group &&
+        (g.Keys[t][0] == key || g.Keys[t][1] == key || g.Keys[t][2] == key))
       {
         return true;
       }
@@ -531,7 +746,7 @@ private:
     return t;
   }
 
-  void KeyPosition(std::int64_t key, const CubeState& st, int i, int j, int k, int e, double x[3])
+  void KeyPosition(std::int64_t key, int e, const CubeState& st, double x[3]) const
   {
     int p[3], axis;
     this->G.Decode(key, p, axis);
@@ -542,9 +757,6 @@ private:
     }
     else
     {
-      (void)i;
-      (void)j;
-      (void)k;
       this->EdgePosition(p, axis, st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], x);
     }
   }
@@ -553,6 +765,21 @@ private:
   /// border, as vtkMarchingCubes computes it.
   void Gradient(int i, int j, int k, double n[3])
   {
+    if (i >= this->CentralLo[0] && i <= this->CentralHi[0] && j >= this->CentralLo[1] &&
+      j <= this->CentralHi[1] && k >= this->CentralLo[2] && k <= this->CentralHi[2])
+    {
+      // Central differences on all axes, the samples at hand: the common case.
+      const std::int64_t at = this->G.LocalIndex(i, j, k);
+      const std::int64_t sy = this->G.StrideY, sz = this->G.StrideZ;
+      n[0] = 0.5 * (static_cast<double>(this->Vals[at - 1]) - static_cast<double>(this->Vals[at + 1]));
+      n[1] = 0.5 * (static_cast<double>(this->Vals[at - sy]) - static_cast<double>(this->Vals[at + sy]));
+      n[2] = 0.5 * (static_cast<double>(this->Vals[at - sz]) - static_cast<double>(this->Vals[at + sz]));
+      if (std::is_integral<ValueType>::value || (n[0] == n[0] && n[1] == n[1] && n[2] == n[2]))
+      {
+        return;
+      }
+      // A NaN sample: the general path below names it.
+    }
     const int p[3] = { i, j, k };
     const double s0 = this->Read(i, j, k);
     for (int a = 0; a < 3; ++a)
@@ -611,130 +838,7 @@ private:
     out[2] = static_cast<float>(w[2]);
   }
 
-  // ---- vertices ------------------------------------------------------------------------------
-
-  /// The output point of a vertex key, created (position, normal, port check) on first use.
-  /// Meeting a vertex another component created joins the two components.
-  std::int32_t Vertex(std::int64_t key, const int p[3], int axis, double sLo, double sHi, int comp)
-  {
-    bool inserted;
-    const std::int32_t fresh = static_cast<std::int32_t>(this->Mesh.Keys.size());
-    std::int32_t& slot = this->VertexIds.FindOrInsert(key, fresh, inserted);
-    if (!inserted)
-    {
-      const std::int32_t id = slot;
-      this->Join(this->Mesh.VertexComponent[id], comp);
-      return id;
-    }
-    double x[3];
-    float normal[3] = { 0, 0, 0 };
-    if (axis < 0)
-    {
-      const double idx[3] = { double(p[0]), double(p[1]), double(p[2]) };
-      this->ToWorld(idx, x);
-      if (this->P.ComputeNormals)
-      {
-        double g[3];
-        this->Gradient(p[0], p[1], p[2], g);
-        this->FinishNormal(g, normal);
-      }
-    }
-    else
-    {
-      const double t = this->EdgePosition(p, axis, sLo, sHi, x);
-      if (this->P.ComputeNormals)
-      {
-        double g0[3], g1[3], g[3];
-        int q[3] = { p[0], p[1], p[2] };
-        this->Gradient(q[0], q[1], q[2], g0);
-        ++q[axis];
-        this->Gradient(q[0], q[1], q[2], g1);
-        for (int a = 0; a < 3; ++a)
-        {
-          g[a] = g0[a] + t * (g1[a] - g0[a]);
-        }
-        this->FinishNormal(g, normal);
-      }
-    }
-    LocalMesh& m = this->Mesh;
-    m.Points.insert(m.Points.end(), x, x + 3);
-    m.Normals.insert(m.Normals.end(), normal, normal + 3);
-    m.Keys.push_back(key);
-    m.VertexComponent.push_back(comp);
-    Component& c = this->Components[this->Root(comp)];
-    c.MinKey = std::min(c.MinKey, key);
-    if (this->IsPort(p, axis))
-    {
-      this->Ports.push_back(Port{ key, comp });
-    }
-    return fresh;
-  }
-
-  std::int32_t EdgeVertex(int i, int j, int k, int e, const CubeState& st, int comp)
-  {
-    int p[3];
-    this->EdgeLowPoint(i, j, k, e, p);
-    const int axis = this->EdgeAxisOf[e];
-    return this->Vertex(this->G.EdgeKey(p[0], p[1], p[2], axis), p, axis,
-      st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], comp);
-  }
-
-  std::int32_t KeyVertex(std::int64_t key, int e, const CubeState& st, int comp)
-  {
-    int p[3], axis;
-    this->G.Decode(key, p, axis);
-    return this->Vertex(key, p, axis, st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], comp);
-  }
-
-  /// Whether a cube that contains this vertex lies in the volume but not in this rank's cubes.
-  bool IsPort(const int p[3], int axis) const
-  {
-    for (int d = 0; d < 8; ++d)
-    {
-      const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
-      if (axis >= 0 && o[axis] != 0)
-      {
-        continue; // an edge lies in the 4 cubes around it, not 8
-      }
-      const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
-      if (this->G.HasCell(i, j, k) && !this->Own.Owns(i, j, k))
-      {
-        return true;
-      }
-    }
-    return false;
-  }
-
-  void Join(int a, int b)
-  {
-    a = this->Root(a);
-    b = this->Root(b);
-    if (a == b)
-    {
-      return;
-    }
-    if (b < a)
-    {
-      std::swap(a, b);
-    }
-    ++this->JoinCount;
-    Component& keep = this->Components[a];
-    const Component& gone = this->Components[b];
-    keep.Seeded = keep.Seeded || gone.Seeded;
-    keep.Triangles += gone.Triangles;
-    keep.MinKey = std::min(keep.MinKey, gone.MinKey);
-    this->Components[b].Parent = a;
-  }
-
-  void AddTriangle(const std::int32_t ids[3], int comp)
-  {
-    LocalMesh& m = this->Mesh;
-    m.Triangles.insert(m.Triangles.end(), ids, ids + 3);
-    m.TriangleComponent.push_back(comp);
-    ++this->Components[this->Root(comp)].Triangles;
-  }
-
-  // ---- visiting ------------------------------------------------------------------------------
+  // ---- phase 1 internals ---------------------------------------------------------------------
 
   std::int64_t BoxIndex(int i, int j, int k) const
   {
@@ -759,9 +863,10 @@ private:
     return mask && ((*mask >> group) & 1);
   }
 
-  /// Marks node (cube, group) visited and queues it. Cubes with one node use only the bit per
-  /// cube; cubes with several remember which nodes were taken until all are.
-  void Mark(int i, int j, int k, std::int64_t bit, int group, int numGroups)
+  /// Marks node (cube, group) found and appends it to the node list (the queue). Cubes with one
+  /// node use only the bit per cube; cubes with several remember which nodes were taken.
+  void Mark(int i, int j, int k, std::int64_t bit, const CubeState& st, int group, int numGroups,
+    int comp)
   {
     if (numGroups == 1)
     {
@@ -781,19 +886,21 @@ private:
         this->SetDone(bit);
       }
     }
-    this->Stack.push_back(Node{ i, j, k, group });
+    this->Nodes.push_back(Node{ i, j, k, comp, static_cast<std::uint8_t>(st.Case),
+      static_cast<std::uint8_t>(group), st.Degenerate });
   }
 
-  /// Queues the nodes of cube (i, j, k) that use vertex `key`. `edge` is the cube's local edge
-  /// carrying the vertex (ignored for a grid-point key).
-  void Visit(int i, int j, int k, std::int64_t key, int edge)
+  /// Marks the nodes of cube (i, j, k) that use vertex `key`. `edge` is the cube's local edge
+  /// carrying the vertex (ignored for a grid-point key). `seen` is set when such a node was
+  /// found before.
+  void Visit(int i, int j, int k, std::int64_t key, int edge, int comp, bool* seen)
   {
-    if (!this->G.HasCell(i, j, k) || !this->Own.Owns(i, j, k))
+    if (!this->Own.Owns(i, j, k)) // owned cubes lie inside the volume
     {
       return;
     }
     const std::int64_t bit = this->BoxIndex(i, j, k);
-    if (this->Done(bit))
+    if (this->Done(bit) && !seen)
     {
       return;
     }
@@ -808,7 +915,15 @@ private:
       const int sheet = edge >= 0 ? ce.EdgeSheet[edge] : -1;
       if (sheet >= 0)
       {
-        this->Mark(i, j, k, bit, sheet, ce.NumSheets);
+        if (this->GroupVisited(bit, sheet, ce.NumSheets))
+        {
+          if (seen)
+          {
+            *seen = true;
+          }
+          return;
+        }
+        this->Mark(i, j, k, bit, st, sheet, ce.NumSheets, comp);
       }
       return;
     }
@@ -816,23 +931,33 @@ private:
     this->ComputeGroups(i, j, k, st, g);
     for (int group = 0; group < g.NumGroups; ++group)
     {
-      if (GroupHasKey(g, group, key) && !this->GroupVisited(bit, group, g.NumGroups))
+      if (!GroupHasKey(g, group, key))
       {
-        this->Mark(i, j, k, bit, group, g.NumGroups);
+        continue;
       }
+      if (this->GroupVisited(bit, group, g.NumGroups))
+      {
+        if (seen)
+        {
+          *seen = true;
+        }
+        continue;
+      }
+      this->Mark(i, j, k, bit, st, group, g.NumGroups, comp);
     }
   }
 
   /// Visits every cube that contains the vertex `key` (at grid point p; `axis` < 0 for a
   /// grid-point vertex), except `from`.
-  void VisitAroundKey(std::int64_t key, const int p[3], int axis, const int* from)
+  void VisitAroundKey(
+    std::int64_t key, const int p[3], int axis, const int* from, int comp, bool* seen = nullptr)
   {
     for (int d = 0; d < 8; ++d)
     {
       const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
       if (axis >= 0 && o[axis] != 0)
       {
-        continue;
+        continue; // an edge lies in the 4 cubes around it, not 8
       }
       const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
       if (from && i == from[0] && j == from[1] && k == from[2])
@@ -846,36 +971,17 @@ private:
         const int v = axis == 2 ? 1 : 2;
         edge = this->EdgeAt[axis][o[u]][o[v]];
       }
-      this->Visit(i, j, k, key, edge);
+      this->Visit(i, j, k, key, edge, comp, seen);
     }
   }
 
-  /// Emits the triangles of one node and queues its neighbours.
-  void Process(const Node& n, int comp)
+  /// Visits the neighbours of one node: every other cube that has one of its vertices.
+  void Expand(const Node& n)
   {
-    CubeState st;
-    if (!this->Evaluate(n.I, n.J, n.K, st))
-    {
-      return;
-    }
     const int from[3] = { n.I, n.J, n.K };
-    if (!st.Degenerate)
+    if (!n.Degenerate)
     {
-      const CaseEntry& ce = this->Table[st.Case];
-      for (int t = 0; t < ce.NumTriangles; ++t)
-      {
-        if (ce.TriangleSheet[t] != n.Group)
-        {
-          continue;
-        }
-        std::int32_t ids[3];
-        for (int v = 0; v < 3; ++v)
-        {
-          ids[v] = this->EdgeVertex(n.I, n.J, n.K, ce.Triangles[t][v], st, comp);
-        }
-        this->AddTriangle(ids, comp);
-      }
-      unsigned edges = ce.SheetEdges[n.Group];
+      unsigned edges = this->Table[n.Case].SheetEdges[n.Group];
       while (edges)
       {
         const int e = __builtin_ctz(edges);
@@ -883,75 +989,63 @@ private:
         int p[3];
         this->EdgeLowPoint(n.I, n.J, n.K, e, p);
         const int axis = this->EdgeAxisOf[e];
-        this->VisitAroundKey(this->G.EdgeKey(p[0], p[1], p[2], axis), p, axis, from);
+        this->VisitAroundKey(this->G.EdgeKey(p[0], p[1], p[2], axis), p, axis, from, n.Component);
       }
+      return;
+    }
+    CubeState st;
+    if (!this->Evaluate(n.I, n.J, n.K, st))
+    {
       return;
     }
     Groups g;
     this->ComputeGroups(n.I, n.J, n.K, st, g);
-    std::int64_t seen[3 * MaxTriangles];
-    int numSeen = 0;
+    std::int64_t keys[3 * MaxTriangles];
+    int numKeys = 0;
     for (int t = 0; t < g.NumTriangles; ++t)
     {
-      if (g.Group[t] != n.Group)
+      for (int v = 0; v < 3 && g.Group[t] == n.Group; ++v)
       {
-        continue;
-      }
-      std::int32_t ids[3];
-      for (int v = 0; v < 3; ++v)
-      {
-        ids[v] = this->KeyVertex(g.Keys[t][v], g.Edges[t][v], st, comp);
-        bool known = false;
-        for (int s = 0; s < numSeen; ++s)
+        if (std::find(keys, keys + numKeys, g.Keys[t][v]) == keys + numKeys)
         {
-          known = known || seen[s] == g.Keys[t][v];
-        }
-        if (!known)
-        {
-          seen[numSeen++] = g.Keys[t][v];
+          keys[numKeys++] = g.Keys[t][v];
         }
       }
-      this->AddTriangle(ids, comp);
     }
-    for (int s = 0; s < numSeen; ++s)
+    for (int s = 0; s < numKeys; ++s)
     {
       int p[3], axis;
-      this->G.Decode(seen[s], p, axis);
-      this->VisitAroundKey(seen[s], p, axis, from);
+      this->G.Decode(keys[s], p, axis);
+      this->VisitAroundKey(keys[s], p, axis, from, n.Component);
     }
   }
 
-  void Drain(int comp)
+  /// Expands the queued nodes from `head` on, until none is left.
+  void Drain(std::size_t head)
   {
-    while (!this->Stack.empty() && !this->Stopped())
+    for (; head < this->Nodes.size() && !this->Stopped(); ++head)
     {
-      const Node n = this->Stack.back();
-      this->Stack.pop_back();
-      this->Process(n, comp);
-      if ((++this->NodesProcessed & 0x3fff) == 0 && this->P.Progress)
+      const Node n = this->Nodes[head];
+      this->Expand(n);
+      if ((++this->NodesExpanded & 0x3fff) == 0)
       {
-        const double done = static_cast<double>(this->NodesProcessed);
-        if (this->P.Progress(done / (done + 4.0 * this->Stack.size() + (1 << 20))))
-        {
-          this->AbortFlag = true;
-        }
+        // The surface's size is unknown while it grows: an estimate that approaches 1.
+        const double done = static_cast<double>(this->NodesExpanded);
+        this->Report(0.5 * done / (done + 4.0 * (this->Nodes.size() - head) + (1 << 20)));
       }
     }
-    this->Stack.clear();
   }
 
-  /// Starts a new component from every unvisited node of the owned cubes in `region`.
+  /// Starts a new component from every unfound node of the owned cubes in `region`.
   void Scan(const CellBox& region, bool reportProgress)
   {
     CubeState st;
     Groups g;
     for (int k = region.Lo[2]; k <= region.Hi[2] && !this->Stopped(); ++k)
     {
-      if (reportProgress && this->P.Progress &&
-        this->P.Progress(double(k - region.Lo[2]) / (region.Hi[2] - region.Lo[2] + 1)))
+      if (reportProgress)
       {
-        this->AbortFlag = true;
-        break;
+        this->Report(0.5 * (k - region.Lo[2]) / (region.Hi[2] - region.Lo[2] + 1));
       }
       for (int j = region.Lo[1]; j <= region.Hi[1]; ++j)
       {
@@ -976,9 +1070,9 @@ private:
           {
             if (!this->GroupVisited(bit, group, numGroups))
             {
-              const int comp = this->AddComponent(false);
-              this->Mark(i, j, k, bit, group, numGroups);
-              this->Drain(comp);
+              const std::size_t head = this->Nodes.size();
+              this->Mark(i, j, k, bit, st, group, numGroups, this->AddComponent(false));
+              this->Drain(head);
             }
           }
         }
@@ -1016,6 +1110,210 @@ private:
     }
   }
 
+  // ---- phase 2 internals ---------------------------------------------------------------------
+
+  /// Creates the output point of a vertex: position, normal, component, port check.
+  std::int32_t NewVertex(std::int64_t key, const int p[3], int axis, double sLo, double sHi,
+    int comp)
+  {
+    double x[3];
+    float normal[3] = { 0, 0, 0 };
+    if (axis < 0)
+    {
+      const double idx[3] = { double(p[0]), double(p[1]), double(p[2]) };
+      this->ToWorld(idx, x);
+      if (this->P.ComputeNormals)
+      {
+        double g[3];
+        this->Gradient(p[0], p[1], p[2], g);
+        this->FinishNormal(g, normal);
+      }
+    }
+    else
+    {
+      const double t = this->EdgePosition(p, axis, sLo, sHi, x);
+      if (this->P.ComputeNormals)
+      {
+        double g0[3], g1[3], g[3];
+        int q[3] = { p[0], p[1], p[2] };
+        this->Gradient(q[0], q[1], q[2], g0);
+        ++q[axis];
+        this->Gradient(q[0], q[1], q[2], g1);
+        for (int a = 0; a < 3; ++a)
+        {
+          g[a] = g0[a] + t * (g1[a] - g0[a]);
+        }
+        this->FinishNormal(g, normal);
+      }
+    }
+    LocalMesh& m = this->Mesh;
+    const std::int32_t id = static_cast<std::int32_t>(m.Keys.size());
+    if (this->P.DoublePoints)
+    {
+      m.PointsDouble.append(x, 3);
+    }
+    else
+    {
+      const float xf[3] = { static_cast<float>(x[0]), static_cast<float>(x[1]),
+        static_cast<float>(x[2]) };
+      m.Points.append(xf, 3);
+    }
+    if (this->P.ComputeNormals)
+    {
+      m.Normals.append(normal, 3);
+    }
+    m.Keys.push_back(key);
+    m.VertexComponent.push_back(comp);
+    Component& c = this->Components[this->Root(comp)];
+    c.MinKey = std::min(c.MinKey, key);
+    if (this->IsPort(p, axis))
+    {
+      this->Ports.push_back(Port{ key, comp });
+    }
+    return id;
+  }
+
+  /// The output point of a vertex met by component `comp`: made on first use; met again by
+  /// another component, it joins the two.
+  std::int32_t UseVertex(std::int32_t& slot, std::int64_t key, const int p[3], int axis,
+    double sLo, double sHi, int comp, Layer* layer, std::int32_t index)
+  {
+    if (slot >= 0)
+    {
+      this->Join(this->Mesh.VertexComponent[slot], comp);
+      return slot;
+    }
+    slot = this->NewVertex(key, p, axis, sLo, sHi, comp);
+    if (layer)
+    {
+      layer->Touched.push_back(index);
+    }
+    return slot;
+  }
+
+  /// The output point of the vertex on edge e of the current node's cube (not collapsed).
+  std::int32_t EdgeVertex(const Node& n, int e, const CubeState& st)
+  {
+    int p[3];
+    this->EdgeLowPoint(n.I, n.J, n.K, e, p);
+    const int axis = this->EdgeAxisOf[e];
+    const CellBox& box = this->Own.Mine();
+    const std::int32_t index =
+      static_cast<std::int32_t>((p[0] - box.Lo[0]) + this->LayerNx * (p[1] - box.Lo[1]));
+    Layer* layer = axis == 2 ? this->Vertical : this->Slab[p[2] - this->SlabK][axis];
+    return this->UseVertex(layer->Ids[index], this->G.EdgeKey(p[0], p[1], p[2], axis), p, axis,
+      st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], n.Component, layer, index);
+  }
+
+  /// The output point of a vertex of a degenerate cube: an edge vertex, or a grid point.
+  std::int32_t KeyVertex(const Node& n, std::int64_t key, int e, const CubeState& st)
+  {
+    if (!this->G.IsPointKey(key))
+    {
+      return this->EdgeVertex(n, e, st);
+    }
+    int p[3], axis;
+    this->G.Decode(key, p, axis);
+    bool inserted;
+    std::int32_t& slot = this->PointVertices.FindOrInsert(key, -1, inserted);
+    return this->UseVertex(slot, key, p, -1, 0.0, 0.0, n.Component, nullptr, 0);
+  }
+
+  /// Whether a cube that contains this vertex lies in the volume but not in this rank's cubes.
+  bool IsPort(const int p[3], int axis) const
+  {
+    if (this->Own.Overlaps().empty() && p[0] >= this->InnerLo[0] && p[0] <= this->InnerHi[0] &&
+      p[1] >= this->InnerLo[1] && p[1] <= this->InnerHi[1] && p[2] >= this->InnerLo[2] &&
+      p[2] <= this->InnerHi[2])
+    {
+      return false; // the 8 cubes around p lie in this rank's box
+    }
+    for (int d = 0; d < 8; ++d)
+    {
+      const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
+      if (axis >= 0 && o[axis] != 0)
+      {
+        continue;
+      }
+      const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
+      if (this->G.HasCell(i, j, k) && !this->Own.Owns(i, j, k))
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void Join(int a, int b)
+  {
+    a = this->Root(a);
+    b = this->Root(b);
+    if (a == b)
+    {
+      return;
+    }
+    ++this->JoinCount;
+    if (b < a)
+    {
+      std::swap(a, b);
+    }
+    Component& keep = this->Components[a];
+    const Component& gone = this->Components[b];
+    keep.Seeded = keep.Seeded || gone.Seeded;
+    keep.Triangles += gone.Triangles;
+    keep.MinKey = std::min(keep.MinKey, gone.MinKey);
+    this->Components[b].Parent = a;
+  }
+
+  void AddTriangle(const std::int32_t ids[3], int comp)
+  {
+    LocalMesh& m = this->Mesh;
+    m.Triangles.append(ids, 3);
+    m.TriangleComponent.push_back(comp);
+    ++this->Components[this->Root(comp)].Triangles;
+  }
+
+  /// Emits the triangles of one node.
+  void Emit(const Node& n)
+  {
+    CubeState st;
+    if (!this->Evaluate(n.I, n.J, n.K, st))
+    {
+      return;
+    }
+    if (!n.Degenerate)
+    {
+      const CaseEntry& ce = this->Table[n.Case];
+      for (int t = 0; t < ce.NumTriangles; ++t)
+      {
+        if (ce.TriangleSheet[t] == n.Group)
+        {
+          std::int32_t ids[3];
+          for (int v = 0; v < 3; ++v)
+          {
+            ids[v] = this->EdgeVertex(n, ce.Triangles[t][v], st);
+          }
+          this->AddTriangle(ids, n.Component);
+        }
+      }
+      return;
+    }
+    Groups g;
+    this->ComputeGroups(n.I, n.J, n.K, st, g);
+    for (int t = 0; t < g.NumTriangles; ++t)
+    {
+      if (g.Group[t] == n.Group)
+      {
+        std::int32_t ids[3];
+        for (int v = 0; v < 3; ++v)
+        {
+          ids[v] = this->KeyVertex(n, g.Keys[t][v], g.Edges[t][v], st);
+        }
+        this->AddTriangle(ids, n.Component);
+      }
+    }
+  }
+
   const CaseTable& Table;
   const Grid& G;
   const Ownership& Own;
@@ -1025,20 +1323,25 @@ private:
 
   std::int64_t CornerStride[8];
   int EdgeAxisOf[12];
-  const int EdgeAt[3][2][2] = { { { CaseTable::EdgeAt(0, 0, 0), CaseTable::EdgeAt(0, 0, 1) },
-                                  { CaseTable::EdgeAt(0, 1, 0), CaseTable::EdgeAt(0, 1, 1) } },
-    { { CaseTable::EdgeAt(1, 0, 0), CaseTable::EdgeAt(1, 0, 1) },
-      { CaseTable::EdgeAt(1, 1, 0), CaseTable::EdgeAt(1, 1, 1) } },
-    { { CaseTable::EdgeAt(2, 0, 0), CaseTable::EdgeAt(2, 0, 1) },
-      { CaseTable::EdgeAt(2, 1, 0), CaseTable::EdgeAt(2, 1, 1) } } };
+  int EdgeAt[3][2][2];
+  int CentralLo[3], CentralHi[3];
+  int InnerLo[3], InnerHi[3];
 
   std::int64_t BoxNx = 0, BoxNxy = 0;
   std::vector<std::uint64_t> Visited;
   KeyMap MultiGroup{ 64 };
-  KeyMap VertexIds{ 1 << 16 };
-  std::vector<Node> Stack;
-  std::int64_t NodesProcessed = 0;
+  std::vector<Node> Nodes;
+  std::int64_t NodesExpanded = 0;
+
+  Layer Layers[5];
+  Layer* Slab[2][2] = { { nullptr, nullptr }, { nullptr, nullptr } };
+  Layer* Vertical = nullptr;
+  int SlabK = 0;
+  std::int64_t LayerNx = 0;
+  KeyMap PointVertices{ 64 };
+
   std::int64_t JoinCount = 0;
+  double Reported = 0.0;
   std::string ErrorText;
   bool AbortFlag = false;
   bool GhostsMissing = false;

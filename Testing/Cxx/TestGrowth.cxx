@@ -103,6 +103,7 @@ void OneCorner()
   const std::vector<float>& values = vol.Values;
   rgmc::Grower<std::vector<float>> g(Table(), grid, own, values, params);
   const int comp = g.GrowFromKey(grid.EdgeKey(0, 0, 0, 0));
+  g.Extract();
   RGMC_CHECK(comp == 0, "one component");
   RGMC_CHECK(g.Mesh.NumberOfTriangles() == 1 && g.Mesh.NumberOfPoints() == 3, "one triangle");
   RGMC_CHECK(g.Ports.empty(), "no ports on one rank");
@@ -142,6 +143,9 @@ void TwoBlobs()
   {
     rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowFromKey(grid.EdgeKey(4, 1, 1, 0)); // the edge from (4,1,1) to (5,1,1): blob 2
+    RGMC_CHECK(g.GrowFromKey(grid.EdgeKey(5, 1, 1, 1)) == -2, "a second seed on blob 2 finds it grown");
+    RGMC_CHECK(g.GrowFromKey(grid.EdgeKey(0, 0, 0, 0)) == -1, "no surface at that key");
+    g.Extract();
     const std::set<Triangle> tris = KeyTriangles(g.Mesh);
     RGMC_CHECK(tris.size() == 8 && Closed(tris), "seeded growth gives blob 2 only: " << tris.size());
     for (std::int64_t p = 0; p < g.Mesh.NumberOfPoints(); ++p)
@@ -152,6 +156,7 @@ void TwoBlobs()
   {
     rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowAll();
+    g.Extract();
     int roots = 0;
     for (int c = 0; c < static_cast<int>(g.Components.size()); ++c)
     {
@@ -177,6 +182,7 @@ void SampleEqualsIsovalue()
   params.Isovalue = 0.5;
   rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
   g.GrowAll();
+  g.Extract();
   RGMC_CHECK(g.Mesh.NumberOfTriangles() == 0, "collapsed triangles must be dropped");
 
   // A blob whose neighbour sample equals the isovalue: the vertices on that sample's edges are
@@ -188,6 +194,7 @@ void SampleEqualsIsovalue()
   const rgmc::Ownership own2 = OwnAll(grid2);
   rgmc::Grower<std::vector<float>> h(Table(), grid2, own2, pinch.Values, params);
   h.GrowAll();
+  h.Extract();
   const std::set<Triangle> tris = KeyTriangles(h.Mesh);
   int pointKeys = 0;
   for (std::int64_t key : h.Mesh.Keys)
@@ -218,6 +225,7 @@ void SplitOwnership()
   const rgmc::Ownership one = OwnAll(grid);
   rgmc::Grower<std::vector<float>> whole(Table(), grid, one, vol.Values, params);
   whole.GrowAll();
+  whole.Extract();
   const std::set<Triangle> expected = KeyTriangles(whole.Mesh);
 
   std::vector<rgmc::CellBox> boxes(2, grid.WholeCells());
@@ -230,6 +238,7 @@ void SplitOwnership()
     const rgmc::Ownership own(boxes, r);
     rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowAll();
+    g.Extract();
     for (const Triangle& t : KeyTriangles(g.Mesh))
     {
       RGMC_CHECK(united.insert(t).second, "a triangle was extracted by both owners");
@@ -282,6 +291,7 @@ void CostFollowsSurface()
     const rgmc::SeedHit hit = g.NearestVertex(seed, seed, 10.0, 1.0);
     RGMC_CHECK(hit.Found, "the sphere is within the radius");
     g.GrowFromKey(hit.Key);
+    g.Extract();
     reads[n] = counted.Reads;
     triangles[n] = static_cast<std::size_t>(g.Mesh.NumberOfTriangles());
     RGMC_CHECK(Closed(KeyTriangles(g.Mesh)), "the sphere is closed");
@@ -320,6 +330,7 @@ void TraversalIsComplete()
     params.Isovalue = 1.0;
     rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowAll();
+    g.Extract();
     joins += g.Joins();
     triangles += g.Mesh.NumberOfTriangles();
   }
