@@ -1,0 +1,139 @@
+"""Shared by RGMC's pvbatch commands: finding and loading the plugin, opening a volume, and
+running under MPI (re-launching the command under mpiexec when --ranks asks for more ranks)."""
+
+import glob
+import os
+import shutil
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+
+class UsageError(Exception):
+    """A problem with the command line or the input, reported without a traceback."""
+
+
+def find_plugin(explicit=None):
+    """The plugin library: --plugin, $RGMC_PLUGIN, or the project's build tree."""
+    candidates = [explicit, os.environ.get("RGMC_PLUGIN")]
+    candidates += sorted(glob.glob(os.path.join(
+        ROOT, "build", "lib", "paraview-*", "plugins", "RGMarchingCubes", "RGMarchingCubes.so")))
+    for path in candidates:
+        if path and os.path.isfile(path):
+            return os.path.abspath(path)
+    if explicit:
+        raise UsageError("no plugin library at %s" % explicit)
+    return None
+
+
+def load_plugin(explicit=None):
+    """Loads the plugin into ParaView and adds its proxies (RGMarchingCubes, CTPhantom, ...) to
+    paraview.simple. A plugin already loaded (auto-loaded from PV_PLUGIN_PATH) is used as is."""
+    from paraview import simple
+    if hasattr(simple, "RGMarchingCubes") and not explicit:
+        return None
+    path = find_plugin(explicit)
+    if path is None:
+        raise UsageError("cannot find the RGMarchingCubes plugin: build it (./rgmc build), "
+                         "or pass --plugin PATH, or set RGMC_PLUGIN")
+    simple.LoadPlugin(path, ns=vars(simple))
+    return path
+
+
+def number_of_ranks():
+    """How many MPI ranks this pvbatch runs on."""
+    from paraview import servermanager
+    return servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
+
+
+def mpiexec_command(ranks):
+    """mpiexec with the flags this MPI needs to run `ranks` processes on this machine."""
+    mpiexec = shutil.which("mpiexec")
+    if not mpiexec:
+        raise UsageError("--ranks %d needs mpiexec (Debian: apt-get install openmpi-bin)" % ranks)
+    command = [mpiexec, "-n", str(ranks)]
+    try:
+        version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True).stdout
+    except OSError:
+        version = ""
+    if "Open MPI" in version or "OpenRTE" in version:
+        command.append("--oversubscribe")  # more ranks than cores is fine for testing
+    return command
+
+
+def mpi_environment():
+    # A pvbatch started without mpiexec is an MPI singleton; its launcher variables would
+    # confuse the mpiexec started from it.
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PMI_"))}
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        # Open MPI refuses to run as root unless told; harmless for other MPIs.
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return env
+
+
+def relaunch(script, argv, ranks, render):
+    """Runs `script argv` again with pvbatch on `ranks` MPI ranks; returns its exit code."""
+    pvbatch = shutil.which("pvbatch")
+    if not pvbatch:
+        raise UsageError("cannot find pvbatch on PATH")
+    command = mpiexec_command(ranks) + [pvbatch, "--mpi"]
+    if render:
+        # Under MPI, pvbatch renders off screen (it hangs otherwise); it still needs an X server.
+        command.append("--force-offscreen-rendering")
+    command += [script] + list(argv)
+    sys.stdout.flush()
+    return subprocess.call(command, env=mpi_environment())
+
+
+def open_volume(spec):
+    """A ParaView source for `spec`: a file ParaView can read, or phantom:N (the CT phantom at
+    N^3) or phantom:NX,NY,NZ."""
+    from paraview import simple
+    if spec.startswith("phantom:"):
+        try:
+            dims = [int(v) for v in spec[len("phantom:"):].split(",")]
+        except ValueError:
+            dims = []
+        if len(dims) == 1:
+            dims *= 3
+        if len(dims) != 3 or min(dims) < 2:
+            raise UsageError("phantom:N or phantom:NX,NY,NZ expects sizes of at least 2, not %r"
+                             % spec)
+        return simple.CTPhantom(Dimensions=dims)
+    if not os.path.exists(spec):
+        raise UsageError("no such file or directory: %s" % spec)
+    source = simple.OpenDataFile(spec)
+    if source is None:
+        raise UsageError("ParaView has no reader for %s" % spec)
+    return source
+
+
+def image_summary(source):
+    """Dimensions and point arrays (name, components, range) of a source's output."""
+    info = source.GetDataInformation()
+    ext = info.GetExtent()
+    dims = [ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1]
+    arrays = []
+    for name in source.PointData.keys():
+        array = source.PointData[name]
+        arrays.append((name, array.GetNumberOfComponents(), array.GetRange(0)))
+    return info.GetDataSetTypeAsString(), dims, arrays
+
+
+def run(main, name):
+    """Runs main(argv) as a pvbatch command. Success returns normally: under MPI, pvbatch must
+    reach its own finalization (sys.exit(0) would skip it and make mpiexec report an abnormal
+    end). A failure exits at once with its code, which ends an MPI job instead of leaving the
+    other ranks waiting."""
+    try:
+        code = main(sys.argv[1:])
+    except UsageError as error:
+        print("%s: error: %s" % (name, error), file=sys.stderr)
+        code = 2
+    if code:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
