@@ -712,16 +712,46 @@ int vtkRGMarchingCubes::RequestData(
 
   // PASS 0: check the input on every rank and agree on the verdict.
   std::string problem;
-  int whole[6] = { 0, -1, 0, -1, 0, -1 };
-  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-  {
-    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  }
-  else if (input)
-  {
-    input->GetExtent(whole);
-  }
   const bool hasPoints = input && input->GetNumberOfPoints() > 0;
+  // The whole extent, agreed by all ranks: the union of what each rank was told and what it
+  // holds (pieces handed over without a pipeline know only their own extent).
+  int whole[6] = { 0, -1, 0, -1, 0, -1 };
+  {
+    int told[6] = { 0, -1, 0, -1, 0, -1 }, held[6] = { 0, -1, 0, -1, 0, -1 };
+    if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+    {
+      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), told);
+    }
+    if (hasPoints)
+    {
+      input->GetExtent(held);
+    }
+    int lows[3], highs[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      lows[a] = VTK_INT_MAX;
+      highs[a] = VTK_INT_MIN;
+      for (const int* e : { told, held })
+      {
+        if (e[1] >= e[0] && e[3] >= e[2] && e[5] >= e[4])
+        {
+          lows[a] = std::min(lows[a], e[2 * a]);
+          highs[a] = std::max(highs[a], e[2 * a + 1]);
+        }
+      }
+    }
+    int agreedLows[3], agreedHighs[3];
+    ranks.C->AllReduce(lows, agreedLows, 3, vtkCommunicator::MIN_OP);
+    ranks.C->AllReduce(highs, agreedHighs, 3, vtkCommunicator::MAX_OP);
+    if (agreedLows[0] <= agreedHighs[0])
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        whole[2 * a] = agreedLows[a];
+        whole[2 * a + 1] = agreedHighs[a];
+      }
+    }
+  }
   vtkDataArray* scalars = nullptr;
   {
     std::ostringstream msg;
@@ -920,9 +950,10 @@ int vtkRGMarchingCubes::RequestData(
         }
       }
     }
-    if (!msg.str().empty())
+    std::string outside = msg.str();
+    if (!ranks.Agree(outside.empty(), outside))
     {
-      vtkWarningMacro(<< "No surface extracted: " << msg.str() << ".");
+      vtkWarningMacro(<< "No surface extracted: " << outside << ".");
       return 1;
     }
 

@@ -1,0 +1,107 @@
+"""Runs the pipeline command as a user does and checks what it writes and says.
+
+  python3 TestPipelineCommand.py --pvbatch pvbatch --script Scripts/rgmc_pipeline.py \
+      --phantom-script Scripts/rgmc_phantom.py --plugin RGMarchingCubes.so --workdir DIR \
+      [--xvfb-run xvfb-run]
+"""
+
+import argparse
+import json
+import os
+import struct
+import subprocess
+import sys
+
+failures = []
+
+
+def check(condition, what):
+    if not condition:
+        failures.append(what)
+        print("FAILED: %s" % what, file=sys.stderr)
+
+
+def run(command, timeout=600):
+    print("+ " + " ".join(command), flush=True)
+    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
+    print(result.stdout)
+    print(result.stderr, file=sys.stderr)
+    return result
+
+
+def stl_triangles(path):
+    with open(path, "rb") as f:
+        f.seek(80)
+        count = struct.unpack("<I", f.read(4))[0]
+    check(os.path.getsize(path) == 84 + 50 * count, "%s is a binary STL of %d triangles" % (path, count))
+    return count
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    for name in ("--pvbatch", "--script", "--phantom-script", "--plugin", "--workdir"):
+        parser.add_argument(name, required=True)
+    parser.add_argument("--xvfb-run")
+    args = parser.parse_args()
+    os.makedirs(args.workdir, exist_ok=True)
+    pipeline = [args.pvbatch, args.script, "--plugin", args.plugin]
+
+    # --help works and names the options.
+    result = run(pipeline + ["--help"])
+    check(result.returncode == 0 and "--isovalue" in result.stdout and "--ranks" in result.stdout, "--help")
+
+    # A volume file written by the phantom generator, then the main job on it (1 rank).
+    volume = os.path.join(args.workdir, "phantom-72.vti")
+    result = run([args.pvbatch, args.phantom_script, "--plugin", args.plugin, "--size", "72",
+                  "--output", volume])
+    check(result.returncode == 0 and os.path.isfile(volume), "the phantom is written")
+    check(b'format="binary"' in open(volume, "rb").read(2000), "inline binary, not appended")
+    prefix = os.path.join(args.workdir, "skull")
+    command = pipeline + ["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--output", prefix]
+    if args.xvfb_run:
+        command = [args.xvfb_run, "-a"] + command + ["--screenshot", prefix + ".png"]
+    result = run(command)
+    check(result.returncode == 0, "the pipeline succeeds")
+    for expected in ("input:", "72 x 72 x 72", "isovalue:   400", "seed:       (0, 0, 105)",
+                     "triangles", "seconds:"):
+        check(expected in result.stdout, "the summary says %r" % expected)
+    report = json.load(open(prefix + ".json"))
+    check(report["triangles"] > 10000, "the skull has many triangles: %d" % report["triangles"])
+    check(stl_triangles(prefix + ".stl") == report["triangles"], "the STL holds every triangle")
+    check(os.path.getsize(prefix + ".vtp") > 1000, "a VTP is written")
+    if args.xvfb_run:
+        png = open(prefix + ".png", "rb").read()
+        check(png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20000, "a PNG picture is written")
+
+    # The same on 2 ranks (the command starts mpiexec itself): the same surface.
+    result = run(pipeline + ["--input", volume, "--isovalue", "400", "--seed", "0,0,105",
+                             "--output", prefix + "-2", "--ranks", "2"])
+    check(result.returncode == 0, "the pipeline succeeds on 2 ranks")
+    report2 = json.load(open(prefix + "-2.json"))
+    check(report2["ranks"] == 2 and report2["triangles"] == report["triangles"],
+          "2 ranks give the same triangles: %d vs %d" % (report2["triangles"], report["triangles"]))
+    check(stl_triangles(prefix + "-2.stl") == report["triangles"], "the 2-rank STL holds every triangle")
+
+    # Bad input: clear messages and a non-zero exit, nothing written.
+    cases = [
+        (["--input", "/no/such/file.vti", "--isovalue", "1", "--seed", "0,0,0"], "no such file"),
+        (["--input", volume, "--isovalue", "400"], "needs at least one --seed"),
+        (["--input", volume, "--isovalue", "400", "--seed", "1,2"], "x,y,z"),
+        (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--array", "nope"], "no point array"),
+        (["--input", volume, "--isovalue", "9000", "--seed", "0,0,105"], "outside the data range"),
+        (["--input", volume, "--isovalue", "400", "--seed", "0,0,900"], "lies outside the volume"),
+    ]
+    for extra, message in cases:
+        result = run(pipeline + extra + ["--output", os.path.join(args.workdir, "bad")])
+        check(result.returncode != 0, "%s: non-zero exit" % " ".join(extra))
+        check(message in result.stdout + result.stderr, "%s: says %r" % (" ".join(extra), message))
+    check(not os.path.exists(os.path.join(args.workdir, "bad.stl")), "nothing written on failure")
+
+    if failures:
+        print("TestPipelineCommand: %d check(s) failed" % len(failures), file=sys.stderr)
+        return 1
+    print("TestPipelineCommand: all checks passed")
+    return 0
+
+
+sys.exit(main())
