@@ -5,6 +5,10 @@
 
 #include <algorithm>
 #include <cstdlib>
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/mman.h>
+#define RGMC_HAVE_MMAP 1
+#endif
 #include <cstring>
 #include <new>
 #include <type_traits>
@@ -84,6 +88,72 @@ private:
   T* Data = nullptr;
   std::size_t Size = 0;
   std::size_t Capacity = 0;
+};
+
+/// A fixed-size array of zeros whose pages come from the operating system as they are first
+/// touched, so a large array that is used sparsely (a bit per cube of the volume) costs what is
+/// touched, not its size. (calloc may instead clear reused heap memory up front.)
+template <typename T>
+class ZeroedArray
+{
+  static_assert(std::is_trivially_copyable<T>::value, "ZeroedArray holds plain values");
+
+public:
+  ZeroedArray() = default;
+  ZeroedArray(const ZeroedArray&) = delete;
+  ZeroedArray& operator=(const ZeroedArray&) = delete;
+  ~ZeroedArray() { this->Free(); }
+
+  /// n zeros (the previous contents are dropped).
+  void Allocate(std::size_t n)
+  {
+    this->Free();
+    this->Bytes = n * sizeof(T);
+    if (n == 0)
+    {
+      return;
+    }
+#ifdef RGMC_HAVE_MMAP
+    if (this->Bytes >= (std::size_t(1) << 20))
+    {
+      void* p = mmap(nullptr, this->Bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED)
+      {
+        throw std::bad_alloc();
+      }
+      this->Data = static_cast<T*>(p);
+      this->Mapped = true;
+      return;
+    }
+#endif
+    this->Data = static_cast<T*>(std::calloc(n, sizeof(T)));
+    if (!this->Data)
+    {
+      throw std::bad_alloc();
+    }
+  }
+  T& operator[](std::size_t i) { return this->Data[i]; }
+  const T& operator[](std::size_t i) const { return this->Data[i]; }
+
+private:
+  void Free()
+  {
+#ifdef RGMC_HAVE_MMAP
+    if (this->Mapped)
+    {
+      munmap(this->Data, this->Bytes);
+      this->Data = nullptr;
+      this->Mapped = false;
+      return;
+    }
+#endif
+    std::free(this->Data);
+    this->Data = nullptr;
+  }
+
+  T* Data = nullptr;
+  std::size_t Bytes = 0;
+  bool Mapped = false;
 };
 
 } // namespace rgmc

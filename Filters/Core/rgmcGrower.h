@@ -187,7 +187,7 @@ public:
     {
       this->BoxNx = box.Hi[0] - box.Lo[0] + 1;
       this->BoxNxy = this->BoxNx * (box.Hi[1] - box.Lo[1] + 1);
-      this->Visited.assign(static_cast<std::size_t>((box.Count() + 63) / 64), 0);
+      this->Visited.Allocate(static_cast<std::size_t>((box.Count() + 63) / 64));
     }
     for (int v = 0; v < 8; ++v)
     {
@@ -472,7 +472,7 @@ public:
     const std::size_t planeSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
     for (auto& layer : this->Layers)
     {
-      layer.Ids.assign(planeSize, -1);
+      layer.Ids.Allocate(planeSize);
       layer.Touched.clear();
     }
     Layer* bottom[2] = { &this->Layers[0], &this->Layers[1] }; // x, y edges at z = k
@@ -533,16 +533,17 @@ private:
     bool Degenerate;
   };
 
-  /// Vertex ids of one plane of edges, with the entries written so far (to reset cheaply).
+  /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
+  /// reset cheaply).
   struct Layer
   {
-    std::vector<std::int32_t> Ids;
+    ZeroedArray<std::int32_t> Ids;
     std::vector<std::int32_t> Touched;
     void Reset()
     {
       for (std::int32_t t : this->Touched)
       {
-        this->Ids[t] = -1;
+        this->Ids[t] = 0;
       }
       this->Touched.clear();
     }
@@ -1173,22 +1174,23 @@ private:
     return id;
   }
 
-  /// The output point of a vertex met by component `comp`: made on first use; met again by
-  /// another component, it joins the two.
+  /// The output point of a vertex met by component `comp`, whose id + 1 is kept in `slot` (0:
+  /// none yet): made on first use; met again by another component, it joins the two.
   std::int32_t UseVertex(std::int32_t& slot, std::int64_t key, const int p[3], int axis,
     double sLo, double sHi, int comp, Layer* layer, std::int32_t index)
   {
-    if (slot >= 0)
+    if (slot > 0)
     {
-      this->Join(this->Mesh.VertexComponent[slot], comp);
-      return slot;
+      this->Join(this->Mesh.VertexComponent[slot - 1], comp);
+      return slot - 1;
     }
-    slot = this->NewVertex(key, p, axis, sLo, sHi, comp);
+    const std::int32_t id = this->NewVertex(key, p, axis, sLo, sHi, comp);
+    slot = id + 1;
     if (layer)
     {
       layer->Touched.push_back(index);
     }
-    return slot;
+    return id;
   }
 
   /// The output point of the vertex on edge e of the current node's cube (not collapsed).
@@ -1215,7 +1217,7 @@ private:
     int p[3], axis;
     this->G.Decode(key, p, axis);
     bool inserted;
-    std::int32_t& slot = this->PointVertices.FindOrInsert(key, -1, inserted);
+    std::int32_t& slot = this->PointVertices.FindOrInsert(key, 0, inserted);
     return this->UseVertex(slot, key, p, -1, 0.0, 0.0, n.Component, nullptr, 0);
   }
 
@@ -1328,7 +1330,7 @@ private:
   int InnerLo[3], InnerHi[3];
 
   std::int64_t BoxNx = 0, BoxNxy = 0;
-  std::vector<std::uint64_t> Visited;
+  ZeroedArray<std::uint64_t> Visited; // a bit per owned cube: its nodes were all found
   KeyMap MultiGroup{ 64 };
   std::vector<Node> Nodes;
   std::int64_t NodesExpanded = 0;
