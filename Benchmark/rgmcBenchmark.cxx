@@ -8,6 +8,7 @@
 // fe (vtkFlyingEdges3D), mc (vtkMarchingCubes, 1 rank only), contour (ParaView's Contour,
 // vtkPVContourFilter). Every method computes normals. vtkRGMarchingCubes gets the piece with
 // its ghost layer (as it asks the pipeline for); the others get the piece without.
+#include "rgmcTestData.h" // pieces with ghost cells, as the pipeline makes them
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGPhantomSource.h"
 
@@ -86,30 +87,6 @@ vtkSmartPointer<vtkImageData> SpherePiece(const int whole[6], const int extent[6
   }
   image->GetPointData()->SetScalars(f);
   return image;
-}
-
-/// Marks the cells outside `owned` as ghosts, as the pipeline does for a ghost level.
-void MarkGhosts(vtkImageData* image, const int owned[6])
-{
-  int ext[6];
-  image->GetExtent(ext);
-  vtkNew<vtkUnsignedCharArray> ghosts;
-  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-  ghosts->SetNumberOfTuples(image->GetNumberOfCells());
-  vtkIdType id = 0;
-  for (int k = ext[4]; k < ext[5]; ++k)
-  {
-    for (int j = ext[2]; j < ext[3]; ++j)
-    {
-      for (int i = ext[0]; i < ext[1]; ++i)
-      {
-        const bool inside = i >= owned[0] && i < owned[1] && j >= owned[2] && j < owned[3] &&
-          k >= owned[4] && k < owned[5];
-        ghosts->SetValue(id++, inside ? 0 : vtkDataSetAttributes::DUPLICATECELL);
-      }
-    }
-  }
-  image->GetCellData()->AddArray(ghosts);
 }
 
 } // namespace
@@ -193,7 +170,7 @@ int main(int argc, char* argv[])
   else
   {
     ghosted = SpherePiece(whole, withGhosts);
-    MarkGhosts(ghosted, owned);
+    rgmc_test::MarkGhostCells(ghosted, owned);
     isovalue = 0;
     seed[0] = 0.61 * whole[1] + 12.0;
     seed[1] = 0.43 * whole[3];

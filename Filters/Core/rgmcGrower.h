@@ -379,8 +379,11 @@ public:
     }
   }
 
-  /// Grows every component that has a node in an owned cube next to a cube of another rank:
-  /// the other half of the distributed seeded growth, which lets every rank work at once.
+  /// Grows every component that has a vertex on a face this rank shares with another rank: the
+  /// other half of the distributed seeded growth, which lets every rank work at once. Only such
+  /// vertices can be shared with another rank's cubes, and they lie on the face's plane of grid
+  /// points: on an edge in the plane, or on a sample equal to the isovalue. So the plane is
+  /// scanned, one sample per point, instead of the layer of cubes along it.
   void GrowBoundary()
   {
     if (this->Own.OwnsNothing())
@@ -391,21 +394,19 @@ public:
     const CellBox whole = this->G.WholeCells();
     for (int a = 0; a < 3 && !this->Stopped(); ++a)
     {
-      for (int side = 0; side < 2; ++side)
+      for (int side = 0; side < 2 && !this->Stopped(); ++side)
       {
         const bool neighbourExists =
           side == 0 ? box.Lo[a] > whole.Lo[a] : box.Hi[a] < whole.Hi[a];
-        if (!neighbourExists)
+        if (neighbourExists)
         {
-          continue;
+          this->GrowFromPlane(a, side == 0 ? box.Lo[a] : box.Hi[a] + 1);
         }
-        CellBox layer = box;
-        layer.Lo[a] = layer.Hi[a] = side == 0 ? box.Lo[a] : box.Hi[a];
-        this->Scan(layer, false);
       }
     }
     for (const CellBox& lower : this->Own.Overlaps())
     {
+      // Ownership with holes (a reader that ignored piece requests): every cube near them.
       this->Scan(lower.Grown(1).Intersect(box), false);
     }
   }
@@ -1033,6 +1034,54 @@ private:
         // The surface's size is unknown while it grows: an estimate that approaches 1.
         const double done = static_cast<double>(this->NodesExpanded);
         this->Report(0.5 * done / (done + 4.0 * (this->Nodes.size() - head) + (1 << 20)));
+      }
+    }
+  }
+
+  /// Grows a new component from the nodes that use vertex `key`, unless they were found.
+  void GrowUnseeded(std::int64_t key, const int p[3], int axis)
+  {
+    const std::size_t head = this->Nodes.size();
+    const int comp = this->AddComponent(false);
+    this->VisitAroundKey(key, p, axis, nullptr, comp);
+    if (this->Nodes.size() == head)
+    {
+      this->Components.pop_back();
+      return;
+    }
+    this->Drain(head);
+  }
+
+  /// Grows from every vertex on the plane of grid points p[axis] = `plane` of this rank's box.
+  void GrowFromPlane(int axis, int plane)
+  {
+    const CellBox& box = this->Own.Mine();
+    const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+    int p[3];
+    p[axis] = plane;
+    for (p[v] = box.Lo[v]; p[v] <= box.Hi[v] + 1 && !this->Stopped(); ++p[v])
+    {
+      for (p[u] = box.Lo[u]; p[u] <= box.Hi[u] + 1 && !this->Stopped(); ++p[u])
+      {
+        const double s = this->Read(p[0], p[1], p[2]);
+        if (s == this->C)
+        {
+          this->GrowUnseeded(this->G.PointKey(p[0], p[1], p[2]), p, -1);
+        }
+        for (const int along : { u, v })
+        {
+          if (p[along] > box.Hi[along])
+          {
+            continue;
+          }
+          int q[3] = { p[0], p[1], p[2] };
+          ++q[along];
+          const double t = this->Read(q[0], q[1], q[2]);
+          if ((s >= this->C) != (t >= this->C) && s != this->C && t != this->C)
+          {
+            this->GrowUnseeded(this->G.EdgeKey(p[0], p[1], p[2], along), p, along);
+          }
+        }
       }
     }
   }

@@ -7,6 +7,9 @@
 
 #include "vtkAppendPolyData.h"
 #include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkCleanPolyData.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
@@ -283,6 +286,42 @@ inline std::ostream& operator<<(std::ostream& os, const Comparison& c)
             << ", unmatched vertices " << c.Unmatched << ", float-merged " << c.Merged
             << ", extra " << c.ExtraOurs << ", missing " << c.MissingTheirs << ", max distance "
             << c.MaxDistance << ", max normal error " << c.MaxNormalError;
+}
+
+/// Marks the cells of `image` outside the cells of `owned` (a point extent) as ghost cells
+/// (DUPLICATECELL), as the pipeline does for a ghost level.
+inline void MarkGhostCells(vtkImageData* image, const int owned[6])
+{
+  int ext[6];
+  image->GetExtent(ext);
+  vtkNew<vtkUnsignedCharArray> ghosts;
+  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  ghosts->SetNumberOfTuples(image->GetNumberOfCells());
+  vtkIdType id = 0;
+  for (int k = ext[4]; k < ext[5]; ++k)
+  {
+    for (int j = ext[2]; j < ext[3]; ++j)
+    {
+      for (int i = ext[0]; i < ext[1]; ++i)
+      {
+        const bool inside = i >= owned[0] && i < owned[1] && j >= owned[2] && j < owned[3] &&
+          k >= owned[4] && k < owned[5];
+        ghosts->SetValue(id++, inside ? 0 : vtkDataSetAttributes::DUPLICATECELL);
+      }
+    }
+  }
+  image->GetCellData()->AddArray(ghosts);
+}
+
+/// The point extent of `owned` (a point extent) widened by `levels` ghost layers, within
+/// `whole`.
+inline void WithGhostLayers(const int owned[6], const int whole[6], int levels, int out[6])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    out[2 * a] = std::max(whole[2 * a], owned[2 * a] - levels);
+    out[2 * a + 1] = std::min(whole[2 * a + 1], owned[2 * a + 1] + levels);
+  }
 }
 
 /// Collects the error and warning messages a VTK object emits.

@@ -1,0 +1,493 @@
+// Distributed vtkRGMarchingCubes. Run on 1 rank (vtkDummyController) and under mpiexec on N
+// ranks: for every field and decomposition, the union of the pieces must equal the 1-rank
+// output in all modes: the same triangles over the same vertex keys, bitwise-identical
+// coordinates and normals, identical ComponentIds, no triangle twice. Errors must be collective:
+// a problem on one rank gives every rank the same message and an empty output.
+//
+// Decompositions: ParaView's block split (with a ghost layer), slabs along each axis, the whole
+// volume on rank 0 and nothing elsewhere, a rank with no data, and every rank holding the whole
+// volume (a reader that ignored the piece requests).
+//
+// Fields: random blobs (many components), a helical tube and a wavy sheet that cross the
+// partition planes again and again, two blocks that meet only around the corner where 8 ranks
+// meet, two bars that meet only along the edge where 4 ranks meet, and the CT phantom (with
+// spacing and origin).
+#include "rgmcTestData.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkDummyController.h"
+#include "vtkExtentTranslator.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkIntArray.h"
+#include "vtkMPIController.h"
+#include "vtkRGMarchingCubes.h"
+#include "vtkRGPhantomSource.h"
+
+#include <cstring>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <sstream>
+
+using namespace rgmc_test;
+
+namespace
+{
+
+constexpr int N = 33; // 32 cells per axis: even splits for 2, 4 and 8 ranks
+const int Whole[6] = { 0, N - 1, 0, N - 1, 0, N - 1 };
+const double Pi = 3.14159265358979323846;
+
+using Seeds = std::vector<std::array<double, 3>>;
+
+struct Field
+{
+  std::string Name;
+  double Isovalue;
+  std::vector<Seeds> SeedSets;
+  /// The field's samples over a point extent (with its spacing and origin).
+  std::function<vtkSmartPointer<vtkImageData>(const int extent[6])> Make;
+};
+
+Field IndexField(const std::string& name, int type, std::function<double(int, int, int)> f,
+  double isovalue, std::vector<Seeds> seeds)
+{
+  return Field{ name, isovalue, std::move(seeds),
+    [type, f](const int extent[6]) { return MakeImage(extent, type, f); } };
+}
+
+std::vector<Field> Fields()
+{
+  std::vector<Field> fields;
+  fields.push_back(IndexField("blobs", VTK_FLOAT, Blobs(Whole, 40, 5), 0.3,
+    { { { 10.2, 20.7, 5.1 } }, { { 3.3, 4.4, 5.5 }, { 28.1, 27.2, 26.3 }, { 16.4, 8.2, 30.1 } } }));
+
+  // A tube of radius 2.2 coiled around the z axis (radius 10, pitch 6): it crosses every
+  // partition plane again and again.
+  fields.push_back(IndexField("helix", VTK_DOUBLE,
+    [](int i, int j, int k) {
+      const double x = i - 16.0, y = j - 16.0;
+      const double rho = std::sqrt(x * x + y * y), theta = std::atan2(y, x);
+      double dz = k - 6.0 * theta / (2 * Pi);
+      dz -= 6.0 * std::floor(dz / 6.0 + 0.5);
+      return 2.2 - std::sqrt((rho - 10.0) * (rho - 10.0) + dz * dz);
+    },
+    0.0, { { { 26.0, 16.0, 0.5 } } }));
+
+  // A wavy sheet that winds back and forth across the planes x = 16, y = 16 and z = 16.
+  fields.push_back(IndexField("comb", VTK_FLOAT,
+    [](int i, int j, int k) {
+      return (i - 16.0) - 6.0 * std::sin(2 * Pi * j / 7.3) * std::cos(2 * Pi * k / 9.1) -
+        3.0 * std::sin(2 * Pi * k / 5.3);
+    },
+    0.0, { { { 16.0, 16.0, 16.0 } } }));
+
+  // Two blocks of inside samples, one in the octant above the centre (16, 16, 16) and one
+  // below it, sharing only the centre: where 8 ranks meet in a 2 x 2 x 2 split.
+  fields.push_back(IndexField("corner", VTK_UNSIGNED_CHAR,
+    [](int i, int j, int k) {
+      const int d[3] = { i - 16, j - 16, k - 16 };
+      const bool above = d[0] >= 0 && d[1] >= 0 && d[2] >= 0 && d[0] <= 5 && d[1] <= 5 && d[2] <= 5;
+      const bool below = d[0] <= 0 && d[1] <= 0 && d[2] <= 0 && d[0] >= -5 && d[1] >= -5 && d[2] >= -5;
+      return above || below ? 2.0 : 0.0;
+    },
+    1.0, { { { 20.0, 20.0, 20.0 } }, { { 16.0, 16.0, 16.0 } } }));
+
+  // Two bars along z, one on each side of the line x = y = 16, sharing only that line: where
+  // 4 ranks meet.
+  fields.push_back(IndexField("edge", VTK_SHORT,
+    [](int i, int j, int k) {
+      const int x = i - 16, y = j - 16;
+      const bool bar1 = x >= 0 && y >= 0 && x <= 4 && y <= 4;
+      const bool bar2 = x <= 0 && y <= 0 && x >= -4 && y >= -4;
+      return (bar1 || bar2) && k >= 3 && k <= 29 ? 100.0 : -100.0;
+    },
+    0.0, { { { 19.0, 19.0, 10.0 } } }));
+
+  // The CT phantom (int16 HU, spacing and origin): skull, mandible and vertebrae.
+  fields.push_back(Field{ "phantom", 400.0, { { { 0, 0, 105 } }, { { 0, 65, -75 }, { 0, -20, -96 } } },
+    [](const int extent[6]) {
+      vtkNew<vtkRGPhantomSource> phantom;
+      phantom->SetDimensions(N, N, N);
+      phantom->UpdateExtent(const_cast<int*>(extent));
+      auto image = vtkSmartPointer<vtkImageData>::New();
+      image->DeepCopy(phantom->GetOutput());
+      image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
+      return image;
+    } });
+  return fields;
+}
+
+/// What one rank holds in a decomposition: its owned points (empty box for none) and whether
+/// it gets a ghost layer (as the pipeline gives) or not (a reader that ignores requests).
+struct Piece
+{
+  int Owned[6] = { 0, -1, 0, -1, 0, -1 };
+  bool Ghosts = true;
+  bool Empty() const { return this->Owned[1] < this->Owned[0]; }
+};
+
+std::vector<std::string> Decompositions(int ranks)
+{
+  if (ranks == 1)
+  {
+    return { "block" };
+  }
+  return { "block", "slab-x", "slab-y", "slab-z", "rank0", "empty-rank", "overlap" };
+}
+
+Piece PieceOf(const std::string& how, int rank, int ranks)
+{
+  Piece p;
+  auto block = [&](int piece, int pieces) {
+    vtkNew<vtkExtentTranslator> split;
+    split->PieceToExtentThreadSafe(
+      piece, pieces, 0, const_cast<int*>(Whole), p.Owned, vtkExtentTranslator::BLOCK_MODE, 0);
+  };
+  if (how == "block")
+  {
+    block(rank, ranks);
+  }
+  else if (how.rfind("slab-", 0) == 0)
+  {
+    const int axis = how[5] - 'x';
+    std::copy(Whole, Whole + 6, p.Owned);
+    p.Owned[2 * axis] = (N - 1) * rank / ranks;
+    p.Owned[2 * axis + 1] = (N - 1) * (rank + 1) / ranks;
+  }
+  else if (how == "rank0")
+  {
+    if (rank == 0)
+    {
+      std::copy(Whole, Whole + 6, p.Owned);
+    }
+    p.Ghosts = false;
+  }
+  else if (how == "empty-rank")
+  {
+    const int empty = ranks / 2;
+    if (rank != empty)
+    {
+      block(rank < empty ? rank : rank - 1, ranks - 1);
+    }
+  }
+  else if (how == "overlap")
+  {
+    std::copy(Whole, Whole + 6, p.Owned);
+    p.Ghosts = false;
+  }
+  return p;
+}
+
+vtkSmartPointer<vtkImageData> MakePiece(const Field& field, const Piece& piece)
+{
+  if (piece.Empty())
+  {
+    return vtkSmartPointer<vtkImageData>::New();
+  }
+  int extent[6];
+  WithGhostLayers(piece.Owned, Whole, piece.Ghosts ? 1 : 0, extent);
+  vtkSmartPointer<vtkImageData> image = field.Make(extent);
+  if (piece.Ghosts)
+  {
+    MarkGhostCells(image, piece.Owned);
+  }
+  return image;
+}
+
+struct Run
+{
+  vtkSmartPointer<vtkPolyData> Output;
+  std::string Errors, Warnings;
+};
+
+Run Extract(vtkMultiProcessController* controller, vtkImageData* image, double isovalue,
+  int mode, const Seeds& seeds, const std::function<void(vtkRGMarchingCubes*)>& tweak = nullptr)
+{
+  vtkNew<vtkRGMarchingCubes> rg;
+  vtkNew<MessageCatcher> catcher;
+  catcher->Watch(rg);
+  rg->SetController(controller);
+  rg->SetInputData(image);
+  rg->SetIsovalue(isovalue);
+  rg->SetExtractionMode(mode);
+  for (const auto& s : seeds)
+  {
+    rg->AddSeedPoint(s[0], s[1], s[2]);
+  }
+  if (tweak)
+  {
+    tweak(rg);
+  }
+  rg->Update();
+  Run r;
+  r.Output = vtkSmartPointer<vtkPolyData>::New();
+  r.Output->ShallowCopy(rg->GetOutput());
+  r.Errors = catcher->Errors;
+  r.Warnings = catcher->Warnings;
+  return r;
+}
+
+/// A surface by vertex keys: triangles (sorted key triples) with their ComponentId, and each
+/// key's coordinates and normal as bits.
+struct Snapshot
+{
+  std::map<std::array<long long, 3>, int> Triangles;
+  std::map<long long, std::array<std::uint32_t, 6>> Vertices;
+  long long DuplicatedTriangles = 0;
+  long long InconsistentVertices = 0;
+  long long WrongRankIds = 0;
+
+  void Add(vtkPolyData* pd, int rank)
+  {
+    vtkIdTypeArray* keys = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+    vtkIntArray* comps = vtkIntArray::SafeDownCast(pd->GetCellData()->GetArray("ComponentId"));
+    vtkIntArray* ranks = vtkIntArray::SafeDownCast(pd->GetCellData()->GetArray("RankId"));
+    vtkDataArray* normals = pd->GetPointData()->GetNormals();
+    if (pd->GetNumberOfPoints() == 0)
+    {
+      return;
+    }
+    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
+    {
+      float x[3], n[3];
+      double xd[3], nd[3];
+      pd->GetPoint(p, xd);
+      normals->GetTuple(p, nd);
+      std::array<std::uint32_t, 6> bits;
+      for (int a = 0; a < 3; ++a)
+      {
+        x[a] = static_cast<float>(xd[a]);
+        n[a] = static_cast<float>(nd[a]);
+        std::memcpy(&bits[a], &x[a], 4);
+        std::memcpy(&bits[3 + a], &n[a], 4);
+      }
+      auto inserted = this->Vertices.emplace(keys->GetValue(p), bits);
+      if (!inserted.second && inserted.first->second != bits)
+      {
+        ++this->InconsistentVertices;
+      }
+    }
+    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
+    {
+      vtkIdType npts;
+      const vtkIdType* pts;
+      pd->GetCellPoints(t, npts, pts);
+      std::array<long long, 3> tri = { keys->GetValue(pts[0]), keys->GetValue(pts[1]),
+        keys->GetValue(pts[2]) };
+      std::sort(tri.begin(), tri.end());
+      if (!this->Triangles.emplace(tri, comps->GetValue(t)).second)
+      {
+        ++this->DuplicatedTriangles;
+      }
+      this->WrongRankIds += ranks->GetValue(t) != rank;
+    }
+  }
+};
+
+long long Failures = 0;
+
+/// Gathers the pieces on rank 0 and compares their union with the reference.
+void CompareUnion(vtkMultiProcessController* controller, vtkPolyData* piece,
+  const Snapshot* reference, const std::string& what)
+{
+  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
+  controller->Gather(piece, pieces, 0);
+  long long failed = 0;
+  if (controller->GetLocalProcessId() == 0)
+  {
+    Snapshot united;
+    for (std::size_t r = 0; r < pieces.size(); ++r)
+    {
+      united.Add(vtkPolyData::SafeDownCast(pieces[r]), static_cast<int>(r));
+    }
+    const bool same = united.Triangles == reference->Triangles && united.Vertices == reference->Vertices;
+    RGMC_CHECK(same, what << ": the union differs from 1 rank: " << united.Triangles.size()
+                          << " vs " << reference->Triangles.size() << " triangles, "
+                          << united.Vertices.size() << " vs " << reference->Vertices.size() << " vertices");
+    RGMC_CHECK(united.DuplicatedTriangles == 0, what << ": " << united.DuplicatedTriangles << " triangles on two ranks");
+    RGMC_CHECK(united.InconsistentVertices == 0, what << ": " << united.InconsistentVertices << " vertices differ between ranks");
+    RGMC_CHECK(united.WrongRankIds == 0, what << ": RankId is not the rank that made the triangle");
+    failed = !same || united.DuplicatedTriangles || united.InconsistentVertices || united.WrongRankIds;
+  }
+  // Every rank reports the same global counts.
+  vtkFieldData* fd = piece->GetFieldData();
+  long long triangles = fd->GetArray("NumberOfTriangles") ?
+    vtkIdTypeArray::SafeDownCast(fd->GetArray("NumberOfTriangles"))->GetValue(0) : -1;
+  long long lo = 0, hi = 0;
+  controller->AllReduce(&triangles, &lo, 1, vtkCommunicator::MIN_OP);
+  controller->AllReduce(&triangles, &hi, 1, vtkCommunicator::MAX_OP);
+  RGMC_CHECK(lo == hi, what << ": ranks disagree on NumberOfTriangles");
+  Failures += failed;
+}
+
+/// The same text on every rank (compared by hash).
+bool SameOnAllRanks(vtkMultiProcessController* controller, const std::string& text)
+{
+  long long h = static_cast<long long>(std::hash<std::string>()(text) >> 1), lo = 0, hi = 0;
+  controller->AllReduce(&h, &lo, 1, vtkCommunicator::MIN_OP);
+  controller->AllReduce(&h, &hi, 1, vtkCommunicator::MAX_OP);
+  return lo == hi;
+}
+
+/// Strips what differs between ranks in a VTK message (the object's address and the source
+/// line), leaving the text.
+std::string Text(const std::string& message)
+{
+  const std::size_t at = message.find("): ");
+  return at == std::string::npos ? message : message.substr(at + 3);
+}
+
+void CollectiveErrors(vtkMultiProcessController* controller)
+{
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  const Field field = Fields()[0];
+  const Piece piece = PieceOf("block", rank, ranks);
+  const Seeds seed = field.SeedSets[0];
+  auto expect = [&](const std::string& what, const Run& r, const std::string& text, bool error) {
+    const std::string message = Text(error ? r.Errors : r.Warnings);
+    RGMC_CHECK(message.find(text) != std::string::npos,
+      what << " (rank " << rank << "): expected '" << text << "', got [" << r.Errors << "]["
+           << r.Warnings << "]");
+    RGMC_CHECK(r.Output->GetNumberOfCells() == 0, what << " (rank " << rank << "): output not empty");
+    RGMC_CHECK(SameOnAllRanks(controller, message), what << ": the ranks' messages differ");
+  };
+
+  // A 3-component array on one rank only.
+  {
+    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    if (rank == ranks - 1)
+    {
+      vtkNew<vtkFloatArray> vectors;
+      vectors->SetName("f");
+      vectors->SetNumberOfComponents(3);
+      vectors->SetNumberOfTuples(image->GetNumberOfPoints());
+      vectors->Fill(0.5);
+      image->GetPointData()->SetScalars(vectors);
+    }
+    expect("bad array on the last rank", Extract(controller, image, field.Isovalue,
+      vtkRGMarchingCubes::ALL_COMPONENTS, {}), "has 3 components", true);
+  }
+  // NaN samples on the last rank's piece, where the surface passes.
+  {
+    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    if (rank == ranks - 1)
+    {
+      vtkDataArray* f = image->GetPointData()->GetScalars();
+      for (vtkIdType n = 0; n < f->GetNumberOfTuples(); n += 7)
+      {
+        f->SetComponent(n, 0, std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+    expect("NaN on the last rank", Extract(controller, image, field.Isovalue,
+      vtkRGMarchingCubes::ALL_COMPONENTS, {}), "is NaN", true);
+  }
+  // A seed outside the volume.
+  {
+    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    expect("seed outside", Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::SEEDED,
+      { { 16, 16, 90 } }), "lies outside the volume", false);
+  }
+  // An abort on the last rank only: every rank stops with an empty output.
+  {
+    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    vtkNew<vtkCallbackCommand> abort;
+    abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
+      static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
+    });
+    const Run r = Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::ALL_COMPONENTS, {},
+      [&](vtkRGMarchingCubes* rg) {
+        if (rank == ranks - 1)
+        {
+          rg->AddObserver(vtkCommand::ProgressEvent, abort);
+        }
+      });
+    RGMC_CHECK(r.Output->GetNumberOfCells() == 0, "abort on the last rank (rank " << rank << "): output not empty");
+  }
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  const bool dummy = argc > 1 && std::string(argv[1]) == "--dummy";
+  vtkSmartPointer<vtkMultiProcessController> controller;
+  if (dummy)
+  {
+    controller = vtkSmartPointer<vtkDummyController>::New();
+  }
+  else
+  {
+    controller = vtkSmartPointer<vtkMPIController>::New();
+  }
+  controller->Initialize(&argc, &argv);
+  vtkMultiProcessController::SetGlobalController(controller);
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  vtkNew<vtkDummyController> single;
+
+  const int modes[] = { vtkRGMarchingCubes::SEEDED, vtkRGMarchingCubes::LARGEST_COMPONENT,
+    vtkRGMarchingCubes::ALL_COMPONENTS };
+  const char* modeNames[] = { "seeded", "largest", "all" };
+  int runs = 0;
+  for (const Field& field : Fields())
+  {
+    // The 1-rank reference, on rank 0.
+    std::vector<Snapshot> references;
+    vtkSmartPointer<vtkImageData> whole;
+    if (rank == 0)
+    {
+      whole = field.Make(Whole);
+      for (int mode : modes)
+      {
+        const std::size_t sets = mode == vtkRGMarchingCubes::SEEDED ? field.SeedSets.size() : 1;
+        for (std::size_t s = 0; s < sets; ++s)
+        {
+          Run r = Extract(single, whole, field.Isovalue, mode,
+            mode == vtkRGMarchingCubes::SEEDED ? field.SeedSets[s] : Seeds());
+          RGMC_CHECK(r.Output->GetNumberOfCells() > 0 && r.Errors.empty() && r.Warnings.empty(),
+            field.Name << " " << modeNames[mode] << ": the reference is empty: " << r.Errors << r.Warnings);
+          references.emplace_back();
+          references.back().Add(r.Output, 0);
+        }
+      }
+    }
+    for (const std::string& how : Decompositions(ranks))
+    {
+      vtkSmartPointer<vtkImageData> image = MakePiece(field, PieceOf(how, rank, ranks));
+      std::size_t next = 0;
+      for (int mode : modes)
+      {
+        const std::size_t sets = mode == vtkRGMarchingCubes::SEEDED ? field.SeedSets.size() : 1;
+        for (std::size_t s = 0; s < sets; ++s, ++next)
+        {
+          std::ostringstream what;
+          what << field.Name << ", " << how << " on " << ranks << " ranks, " << modeNames[mode];
+          if (mode == vtkRGMarchingCubes::SEEDED)
+          {
+            what << " (seed set " << s << ")";
+          }
+          Run r = Extract(controller, image, field.Isovalue, mode,
+            mode == vtkRGMarchingCubes::SEEDED ? field.SeedSets[s] : Seeds());
+          RGMC_CHECK(r.Errors.empty() && r.Warnings.empty(), what.str() << ": " << r.Errors << r.Warnings);
+          CompareUnion(controller, r.Output, rank == 0 ? &references[next] : nullptr, what.str());
+          ++runs;
+        }
+      }
+    }
+  }
+  if (ranks > 1)
+  {
+    CollectiveErrors(controller);
+  }
+
+  long long failures = rgmc_test::Failures(), total = 0;
+  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
+  if (rank == 0)
+  {
+    std::cout << "TestDistributed on " << ranks << " ranks: " << runs << " runs compared, "
+              << total << " failed checks\n";
+  }
+  controller->Finalize();
+  return total == 0 ? 0 : 1;
+}
