@@ -1149,8 +1149,11 @@ int vtkRGMarchingCubes::RequestData(
   vtkNew<vtkIdTypeArray> componentCount;
   componentCount->SetName("NumberOfComponents");
   componentCount->InsertNextValue(decision.Components);
-  output->GetFieldData()->AddArray(seedKeyArray);
-  output->GetFieldData()->AddArray(seedPointArray);
+  if (!seedKeys.empty()) // empty arrays would hide the field data from ParaView's information
+  {
+    output->GetFieldData()->AddArray(seedKeyArray);
+    output->GetFieldData()->AddArray(seedPointArray);
+  }
   output->GetFieldData()->AddArray(triangleCount);
   output->GetFieldData()->AddArray(componentCount);
 
