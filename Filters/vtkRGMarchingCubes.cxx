@@ -4,6 +4,7 @@
 
 #include "rgmcCaseTable.h"
 #include "rgmcGrower.h"
+#include "vtkRGCollective.h"
 
 #include "vtkArrayDispatch.h"
 #include "vtkCellArray.h"
@@ -49,122 +50,13 @@ vtkCxxSetObjectMacro(vtkRGMarchingCubes, Controller, vtkMultiProcessController);
 namespace
 {
 
+using rgmc::Ranks;
+constexpr int PortTag = 48731;
+
 const rgmc::CaseTable& Cases()
 {
   static const rgmc::CaseTable table(&vtkMarchingCubesTriangleCases::GetCases()[0].edges[0]);
   return table;
-}
-
-constexpr int PortTag = 48731;
-
-// ---- collectives ---------------------------------------------------------------------------
-
-/// Thin helpers over the controller; every call is made by every rank in the same order.
-class Ranks
-{
-public:
-  explicit Ranks(vtkMultiProcessController* controller)
-    : C(controller)
-    , Rank(controller->GetLocalProcessId())
-    , Size(controller->GetNumberOfProcesses())
-  {
-  }
-
-  /// True when `ok` holds on every rank. Otherwise every rank gets, in `message`, the message of
-  /// the lowest failing rank.
-  bool Agree(bool ok, std::string& message)
-  {
-    int mine = ok ? this->Size : this->Rank, first = this->Size;
-    this->C->AllReduce(&mine, &first, 1, vtkCommunicator::MIN_OP);
-    if (first == this->Size)
-    {
-      return true;
-    }
-    vtkIdType length = this->Rank == first ? static_cast<vtkIdType>(message.size()) : 0;
-    this->C->Broadcast(&length, 1, first);
-    std::vector<char> text(static_cast<std::size_t>(length) + 1, '\0');
-    if (this->Rank == first)
-    {
-      std::copy(message.begin(), message.end(), text.begin());
-    }
-    if (length > 0)
-    {
-      this->C->Broadcast(text.data(), length, first);
-    }
-    message.assign(text.data(), static_cast<std::size_t>(length));
-    return false;
-  }
-
-  bool Any(bool flag)
-  {
-    int mine = flag ? 1 : 0, any = 0;
-    this->C->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP);
-    return any != 0;
-  }
-
-  vtkMultiProcessController* C;
-  const int Rank;
-  const int Size;
-};
-
-/// Pairwise exchange of vtkIdType lists with the ranks marked in `partners` (a symmetric
-/// relation). Rounds follow a round-robin tournament, so every round is a perfect matching and
-/// blocking sends cannot deadlock; the number of rounds depends on the rank count only.
-std::vector<std::vector<vtkIdType>> Exchange(Ranks& ranks,
-  const std::vector<std::vector<vtkIdType>>& outgoing, const std::vector<bool>& partners)
-{
-  std::vector<std::vector<vtkIdType>> incoming(ranks.Size);
-  const int n = ranks.Size + (ranks.Size % 2);
-  const int m = n - 1;
-  const int me = ranks.Rank;
-  for (int round = 0; round < m; ++round)
-  {
-    int partner;
-    if (me == n - 1)
-    {
-      partner = round;
-    }
-    else if (me == round)
-    {
-      partner = n - 1;
-    }
-    else
-    {
-      partner = ((2 * round - me) % m + m) % m;
-    }
-    if (partner >= ranks.Size || partner == me || !partners[partner])
-    {
-      continue;
-    }
-    auto send = [&]() {
-      vtkIdType count = static_cast<vtkIdType>(outgoing[partner].size());
-      ranks.C->Send(&count, 1, partner, PortTag);
-      if (count > 0)
-      {
-        ranks.C->Send(outgoing[partner].data(), count, partner, PortTag + 1);
-      }
-    };
-    auto receive = [&]() {
-      vtkIdType count = 0;
-      ranks.C->Receive(&count, 1, partner, PortTag);
-      incoming[partner].resize(static_cast<std::size_t>(count));
-      if (count > 0)
-      {
-        ranks.C->Receive(incoming[partner].data(), count, partner, PortTag + 1);
-      }
-    };
-    if (me < partner)
-    {
-      send();
-      receive();
-    }
-    else
-    {
-      receive();
-      send();
-    }
-  }
-  return incoming;
 }
 
 // ---- geometry ------------------------------------------------------------------------------
@@ -478,7 +370,8 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
     partners[r] = r != ranks.Rank && !own.Mine().Empty() && !own.BoxOf(r).Empty() &&
       !near.Intersect(own.BoxOf(r)).Empty();
   }
-  const std::vector<std::vector<vtkIdType>> incoming = Exchange(ranks, outgoing, partners);
+  const std::vector<std::vector<vtkIdType>> incoming =
+    ranks.Exchange(outgoing, partners, PortTag);
 
   // Edges of the component graph: my component and theirs share a vertex.
   std::sort(mine.begin(), mine.end());
@@ -1155,6 +1048,14 @@ int vtkRGMarchingCubes::RequestData(
     output->GetFieldData()->AddArray(seedPointArray);
   }
   output->GetFieldData()->AddArray(triangleCount);
+  vtkNew<vtkIntArray> wholeExtent; // lets Seam Repair tell edges on the volume's border
+  wholeExtent->SetName("WholeExtent");
+  wholeExtent->SetNumberOfValues(6);
+  for (int i = 0; i < 6; ++i)
+  {
+    wholeExtent->SetValue(i, whole[i]);
+  }
+  output->GetFieldData()->AddArray(wholeExtent);
   output->GetFieldData()->AddArray(componentCount);
 
   if (decision.Triangles == 0 && ranks.Rank == 0)

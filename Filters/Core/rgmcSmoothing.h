@@ -1,0 +1,220 @@
+// Mesh smoothing that gives the same result on any number of ranks, without VTK: smoothing
+// stencils, the windowed-sinc filter's coefficients, and the update steps of Jacobi Laplacian
+// and windowed-sinc smoothing over a list of vertices.
+//
+// The stencils and the windowed-sinc steps follow vtkWindowedSincPolyDataFilter (VTK 9.2):
+// boundary smoothing on, no feature-edge smoothing, Hamming window, coordinates not normalized.
+// Neighbours are always visited in increasing global id, so the arithmetic of every vertex is
+// fixed by the mesh alone, not by how it is distributed.
+#ifndef rgmcSmoothing_h
+#define rgmcSmoothing_h
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace rgmc
+{
+
+/// An edge of the whole mesh at one vertex: the other end and how many triangles use the edge.
+struct IncidentEdge
+{
+  std::int64_t Neighbour;
+  int Uses;
+};
+
+/// The neighbours a vertex is smoothed toward (empty: the vertex is fixed), by the rules of
+/// vtkWindowedSincPolyDataFilter with boundary smoothing on. `incident` holds the vertex's
+/// distinct edges sorted by neighbour. A vertex whose edges are all manifold (used twice) uses
+/// all its neighbours; one with exactly two boundary edges (used once), or exactly two
+/// non-manifold edges, is smoothed along them unless `exceedsEdgeAngle(a, b)` (the path a,
+/// vertex, b turns by more than the edge angle); anything else is fixed.
+template <typename ExceedsEdgeAngle>
+std::vector<std::int64_t> SmoothingStencil(
+  const std::vector<IncidentEdge>& incident, ExceedsEdgeAngle&& exceedsEdgeAngle)
+{
+  int uses = 0;
+  for (const IncidentEdge& e : incident)
+  {
+    uses += e.Uses;
+  }
+  // No edges, a dangling end, or more than VTK's 255 smoothing edges: fixed.
+  if (uses <= 1 || uses >= 2 * 255)
+  {
+    return {};
+  }
+  std::vector<std::int64_t> all, boundary, nonManifold;
+  for (const IncidentEdge& e : incident)
+  {
+    if (e.Uses == 1)
+    {
+      if (boundary.size() == 2)
+      {
+        return {};
+      }
+      boundary.push_back(e.Neighbour);
+    }
+    else if (e.Uses > 2)
+    {
+      if (nonManifold.size() == 2)
+      {
+        return {};
+      }
+      nonManifold.push_back(e.Neighbour);
+    }
+    all.push_back(e.Neighbour);
+  }
+  if (boundary.empty() && nonManifold.empty())
+  {
+    return all;
+  }
+  for (const std::vector<std::int64_t>* pair : { &boundary, &nonManifold })
+  {
+    const std::vector<std::int64_t>& other = pair == &boundary ? nonManifold : boundary;
+    if (pair->size() == 2 && other.empty())
+    {
+      if (exceedsEdgeAngle((*pair)[0], (*pair)[1]))
+      {
+        return {};
+      }
+      return *pair;
+    }
+  }
+  return {};
+}
+
+/// Whether the path p0 -> p1 -> p2 turns by more than the angle whose cosine is `cosAngle`
+/// (vtkWindowedSincPolyDataFilter's edge-angle test at p1; differences taken in T as there).
+template <typename T>
+bool ExceedsEdgeAngle(const T* p0, const T* p1, const T* p2, double cosAngle)
+{
+  double l1[3], l2[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    l1[k] = static_cast<T>(p1[k] - p0[k]);
+    l2[k] = static_cast<T>(p2[k] - p1[k]);
+  }
+  for (double* l : { l1, l2 })
+  {
+    const double norm = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+    if (norm != 0.0)
+    {
+      l[0] /= norm;
+      l[1] /= norm;
+      l[2] /= norm;
+    }
+  }
+  return l1[0] * l2[0] + l1[1] * l2[1] + l1[2] * l2[2] < cosAngle;
+}
+
+/// The Chebyshev coefficients c[0..iterations] of the windowed-sinc low-pass filter, as
+/// vtkWindowedSincPolyDataFilter computes them (Hamming window, pass band widened by a
+/// Newton-Raphson search so that the filter is 1 at the pass band).
+std::vector<double> SincCoefficients(int iterations, double passBand);
+
+/// Smoothing stencils of many vertices, in compressed rows: the neighbours of vertex row r are
+/// Neighbours[Offsets[r] .. Offsets[r + 1]), indices into the point arrays.
+struct Stencils
+{
+  std::vector<std::int64_t> Offsets{ 0 };
+  std::vector<std::int64_t> Neighbours;
+
+  void Add(const std::vector<std::int64_t>& neighbours)
+  {
+    this->Neighbours.insert(this->Neighbours.end(), neighbours.begin(), neighbours.end());
+    this->Offsets.push_back(static_cast<std::int64_t>(this->Neighbours.size()));
+  }
+};
+
+/// One Jacobi Laplacian step for the vertices `points[r]` with stencil row r:
+/// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T (the
+/// mesh's point type: each step is stored in it, as VTK's filters do).
+template <typename T>
+void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& points,
+  const T* cur, T* next, double relaxation)
+{
+  for (std::size_t r = 0; r < points.size(); ++r)
+  {
+    const std::int64_t v = points[r];
+    const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
+    const double n = static_cast<double>(end - begin);
+    for (int k = 0; k < 3; ++k)
+    {
+      const double x = static_cast<double>(cur[3 * v + k]);
+      double delta = 0.0;
+      for (std::int64_t s = begin; s < end; ++s)
+      {
+        delta += static_cast<double>(cur[3 * stencils.Neighbours[s] + k]) - x;
+      }
+      next[3 * v + k] = static_cast<T>(end > begin ? x + relaxation * delta / n : x);
+    }
+  }
+}
+
+// In the windowed-sinc steps, differences of two coordinates are taken in T, as VTK's loops
+// do (they subtract two tuple values of the points' type), so that float meshes give VTK's
+// result to the bit.
+
+/// The first windowed-sinc step (Taubin): x1 = x0 - 0.5 * sum((x0 - y0) / n),
+/// x3 = c0 x0 + c1 x1 (x1 before it is stored).
+template <typename T>
+void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& points,
+  const T* x0, T* x1, T* x3, const double* c)
+{
+  for (std::size_t r = 0; r < points.size(); ++r)
+  {
+    const std::int64_t v = points[r];
+    const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
+    const double n = static_cast<double>(end - begin);
+    double delta[3] = { 0, 0, 0 };
+    for (std::int64_t s = begin; s < end; ++s)
+    {
+      const std::int64_t w = stencils.Neighbours[s];
+      for (int k = 0; k < 3; ++k)
+      {
+        delta[k] += static_cast<double>(static_cast<T>(x0[3 * v + k] - x0[3 * w + k])) / n;
+      }
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      const double x = static_cast<double>(x0[3 * v + k]);
+      const double first = x - 0.5 * delta[k];
+      x1[3 * v + k] = static_cast<T>(first);
+      x3[3 * v + k] = static_cast<T>(c[0] * x + c[1] * first);
+    }
+  }
+}
+
+/// A later windowed-sinc step: x2 = x1 - x0 + x1 - sum((x1 - y1) / n), x3 += c x2 (x2 before it
+/// is stored).
+template <typename T>
+void SincStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* x0,
+  const T* x1, T* x2, T* x3, double c)
+{
+  for (std::size_t r = 0; r < points.size(); ++r)
+  {
+    const std::int64_t v = points[r];
+    const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
+    const double n = static_cast<double>(end - begin);
+    double delta[3] = { 0, 0, 0 };
+    for (std::int64_t s = begin; s < end; ++s)
+    {
+      const std::int64_t w = stencils.Neighbours[s];
+      for (int k = 0; k < 3; ++k)
+      {
+        delta[k] += static_cast<double>(static_cast<T>(x1[3 * v + k] - x1[3 * w + k])) / n;
+      }
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      const T a = x1[3 * v + k];
+      const double step = static_cast<double>(static_cast<T>(static_cast<T>(a - x0[3 * v + k]) + a)) - delta[k];
+      x2[3 * v + k] = static_cast<T>(step);
+      x3[3 * v + k] = static_cast<T>(static_cast<double>(x3[3 * v + k]) + c * step);
+    }
+  }
+}
+
+} // namespace rgmc
+
+#endif

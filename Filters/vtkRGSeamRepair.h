@@ -1,0 +1,125 @@
+/**
+ * @class   vtkRGSeamRepair
+ * @brief   one watertight, smoothed surface from a distributed triangle mesh
+ *
+ * A surface extracted on N ranks (vtkRGMarchingCubes, or ParaView's Contour) has a copy of every
+ * vertex on a partition seam on each rank that uses it. Tools that look at one rank's piece see
+ * the seam as a border: ParaView's Clean does not merge across ranks, and smoothing filters move
+ * seam vertices as if they were on a boundary, so the pieces no longer fit. vtkRGSeamRepair
+ * identifies the copies across ranks and makes the pieces behave as one mesh:
+ *
+ * - Every vertex gets a global id, `GlobalPointIds`, contiguous from 0 and the same for any
+ *   number of ranks (vertices numbered in the order of their identity). Its owner is the lowest
+ *   rank that uses it; the other ranks' copies are flagged DUPLICATEPOINT in `vtkGhostType`.
+ *   Copies of one vertex on the same rank are merged.
+ * - Global checks, in field data (`UniquePoints`, `Triangles`, `Edges`, `BoundaryEdges`,
+ *   `VolumeBorderEdges`, `NonManifoldEdges`, `EulerCharacteristic`, `Closed`) and in the log:
+ *   a closed surface has no boundary and no non-manifold edge; edges where the surface leaves
+ *   the volume are counted apart (`VolumeBorderEdges`).
+ * - Smoothing that does not see the seams: Laplacian in Jacobi form (default; 20 iterations,
+ *   relaxation 0.01, as Wei et al. use) or windowed sinc (Taubin; the smoother without
+ *   shrinkage, as vtkWindowedSincPolyDataFilter computes it on the merged mesh), with the
+ *   neighbours of seam vertices exchanged every iteration and visited in global-id order, so
+ *   the result is the same, to the bit, on any number of ranks. Normals are recomputed.
+ *
+ * Vertices are identified by the input's point global ids when every rank has them (the
+ * `VertexKey` of vtkRGMarchingCubes), otherwise by their exact coordinates. The input must be
+ * triangles (polygons of 3 points) only.
+ *
+ * ### Distributed execution
+ * Problem: which copies are one vertex, and who owns it, is known only across ranks.
+ * Approach: a rendezvous on ranges of identities, then exchanges with neighbouring ranks only.
+ * Steps:
+ * 1. Each rank sorts its vertex identities; sampled identities give ranges of equal size.
+ * 2. Identities go to the rank of their range, which numbers them in order and tells every
+ *    sender the global id, owner and other holders of each.
+ * 3. The edges around each seam vertex are gathered at its owner: complete edge counts for the
+ *    checks, complete neighbourhoods for the smoothing stencils.
+ * 4. Each smoothing iteration sends, from the ranks that hold them, the neighbour positions
+ *    owners need, then the owners' new positions to the other holders.
+ * Errors are collective: a problem on one rank is reported by every rank.
+ *
+ * @sa vtkRGMarchingCubes vtkWindowedSincPolyDataFilter vtkSmoothPolyDataFilter
+ */
+
+#ifndef vtkRGSeamRepair_h
+#define vtkRGSeamRepair_h
+
+#include "RGMCFiltersModule.h" // For export macro
+#include "vtkPolyDataAlgorithm.h"
+
+class vtkMultiProcessController;
+
+class RGMCFILTERS_EXPORT vtkRGSeamRepair : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkRGSeamRepair* New();
+  vtkTypeMacro(vtkRGSeamRepair, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum SmoothingMethods
+  {
+    NO_SMOOTHING = 0,
+    LAPLACIAN = 1,
+    WINDOWED_SINC = 2
+  };
+
+  ///@{
+  /**
+   * NO_SMOOTHING, LAPLACIAN (default) or WINDOWED_SINC.
+   */
+  vtkSetClampMacro(SmoothingMethod, int, NO_SMOOTHING, WINDOWED_SINC);
+  vtkGetMacro(SmoothingMethod, int);
+  ///@}
+
+  ///@{
+  /**
+   * Smoothing iterations (default 20).
+   */
+  vtkSetClampMacro(NumberOfIterations, int, 0, 100000);
+  vtkGetMacro(NumberOfIterations, int);
+  ///@}
+
+  ///@{
+  /**
+   * Laplacian relaxation factor (default 0.01): each iteration moves a vertex this fraction of
+   * the way to the mean of its neighbours.
+   */
+  vtkSetClampMacro(RelaxationFactor, double, 0.0, 1.0);
+  vtkGetMacro(RelaxationFactor, double);
+  ///@}
+
+  ///@{
+  /**
+   * Windowed-sinc pass band, between 0 and 2 (default 0.1; lower smooths more).
+   */
+  vtkSetClampMacro(PassBand, double, 0.0, 2.0);
+  vtkGetMacro(PassBand, double);
+  ///@}
+
+  ///@{
+  /**
+   * The controller that links the ranks (default: the global controller).
+   */
+  void SetController(vtkMultiProcessController*);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
+protected:
+  vtkRGSeamRepair();
+  ~vtkRGSeamRepair() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int SmoothingMethod = LAPLACIAN;
+  int NumberOfIterations = 20;
+  double RelaxationFactor = 0.01;
+  double PassBand = 0.1;
+  vtkMultiProcessController* Controller = nullptr;
+
+private:
+  vtkRGSeamRepair(const vtkRGSeamRepair&) = delete;
+  void operator=(const vtkRGSeamRepair&) = delete;
+};
+
+#endif
