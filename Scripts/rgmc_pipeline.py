@@ -6,9 +6,10 @@ Run with ParaView's pvbatch:
       --output out/skull --screenshot out/skull.png --ranks 2
 
 reads the volume, grows the surface through the vertex nearest to each seed (Region-Growing
-Marching Cubes, on --ranks MPI ranks), writes <output>.stl, <output>.vtp and <output>.json (what
-was done, with timings) and, with --screenshot, a picture. Rendering needs an X server (run
-under xvfb-run when there is no display).
+Marching Cubes, on --ranks MPI ranks), makes the pieces one watertight mesh and smooths it (Seam
+Repair), writes <output>.stl and <output>.vtp (one mesh, seam vertices merged) and
+<output>.json (what was done, the mesh checks, timings) and, with --screenshot, a picture.
+Rendering needs an X server (run under xvfb-run when there is no display).
 """
 
 import argparse
@@ -21,6 +22,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import rgmc_common  # noqa: E402
 
 MODES = {"seeded": "Seeded", "largest": "Largest Component", "all": "All Components"}
+SMOOTHING = {"laplacian": "Laplacian", "sinc": "Windowed Sinc", "none": "None"}
+CHECKS = ["UniquePoints", "Triangles", "Edges", "BoundaryEdges", "VolumeBorderEdges",
+          "NonManifoldEdges", "EulerCharacteristic", "Closed"]
 
 
 def parse_seed(text):
@@ -55,8 +59,16 @@ def parse_args(argv):
                         "default 10)")
     parser.add_argument("--array", help="the point array to contour (default: the first "
                         "one-component point array)")
+    parser.add_argument("--smooth", choices=["laplacian", "sinc", "none"], default="laplacian",
+                        help="smoothing of the repaired mesh: laplacian (default; relaxation "
+                        "0.01), sinc (windowed sinc, no shrinkage) or none")
+    parser.add_argument("--iterations", type=int, default=20,
+                        help="smoothing iterations (default 20)")
     parser.add_argument("--output", required=True,
-                        help="output prefix: writes PREFIX.stl, PREFIX.vtp and PREFIX.json")
+                        help="output prefix: writes PREFIX.<format> for each of --formats and "
+                        "PREFIX.json")
+    parser.add_argument("--formats", default="stl,vtp",
+                        help="comma-separated formats to write: stl, ply, vtp (default stl,vtp)")
     parser.add_argument("--screenshot", help="also render the surface to this PNG")
     parser.add_argument("--color-by", choices=["solid", "rank", "component"], default="solid",
                         help="colour of the picture: solid, by rank (the decomposition), or by "
@@ -70,21 +82,13 @@ def parse_args(argv):
         parser.error("the seeded mode needs at least one --seed x,y,z")
     if args.ranks < 1:
         parser.error("--ranks must be at least 1")
+    if args.iterations < 0:
+        parser.error("--iterations must be at least 0")
+    args.formats = [f.strip().lower() for f in args.formats.split(",") if f.strip()]
+    for f in args.formats:
+        if f not in ("stl", "ply", "vtp"):
+            parser.error("--formats takes stl, ply and vtp, not %r" % f)
     return args
-
-
-def write_vtp(source, path):
-    """One .vtp file, also from several ranks (ParaView 5.11 has no parallel writer for a
-    single .vtp): the pieces are gathered on the first rank. Inline binary, since Debian 12's
-    expat cannot read VTK's appended XML data back."""
-    from paraview import servermanager
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
-    writer = vtkXMLPolyDataWriter()
-    writer.SetInputData(servermanager.Fetch(source))
-    writer.SetDataModeToBinary()
-    writer.SetFileName(path)
-    if not writer.Write():
-        raise rgmc_common.UsageError("could not write %s" % path)
 
 
 def render(source, args, ranks):
@@ -168,15 +172,13 @@ def main(argv):
     timed.UpdatePipeline()
     extract_seconds = time.time() - started
     simple.Delete(timed)
-    info = surface.GetDataInformation()
-    triangles = info.GetNumberOfCells()
-    points = info.GetNumberOfPoints()
+    triangles = surface.GetDataInformation().GetNumberOfCells()
 
     report = {
         "input": args.input, "dimensions": dims, "array": array, "array_range": list(value_range),
         "isovalue": args.isovalue, "mode": args.mode, "seeds": args.seed,
         "seed_search_radius": args.radius, "ranks": ranks, "triangles": triangles,
-        "points": points, "read_seconds": round(read_seconds, 4),
+        "read_seconds": round(read_seconds, 4),
         "extract_seconds": round(extract_seconds, 4), "total_seconds": round(total_seconds, 4),
         "outputs": [],
     }
@@ -185,24 +187,42 @@ def main(argv):
     print("isovalue:   %g   mode: %s   ranks: %d" % (args.isovalue, args.mode, ranks))
     for seed in args.seed:
         print("seed:       (%g, %g, %g)" % tuple(seed))
-    print("surface:    %d triangles, %d points (points on partition seams counted once per "
-          "rank)" % (triangles, points) if ranks > 1 else
-          "surface:    %d triangles, %d points" % (triangles, points))
+    print("surface:    %d triangles" % triangles)
     print("seconds:    %.3f extraction (%.3f with reading the volume)" % (
         extract_seconds, total_seconds))
     if triangles == 0:
         print("no surface extracted: nothing written (see the warning above)", file=sys.stderr)
         return 2
 
+    # One watertight mesh from the ranks' pieces, smoothed identically on any number of ranks.
+    repaired = simple.RGSeamRepair(Input=surface, SmoothingMethod=SMOOTHING[args.smooth],
+                                   NumberOfIterations=args.iterations)
+    started = time.time()
+    repaired.UpdatePipeline()
+    report["repair_seconds"] = round(time.time() - started, 4)
+    report["smoothing"] = {"method": args.smooth, "iterations": args.iterations}
+    data_information = repaired.GetDataInformation()  # keep it alive while reading it
+    fields = data_information.DataInformation.GetFieldDataInformation()
+    report["checks"] = {name: int(fields.GetArrayInformation(name).GetComponentRange(0)[0])
+                        for name in CHECKS}
+    checks = report["checks"]
+    print("mesh:       %d unique points, %d triangles, %d edges; %d boundary edges (%d more on the "
+          "volume's border), %d non-manifold; Euler characteristic %d: %s" % (
+              checks["UniquePoints"], checks["Triangles"], checks["Edges"], checks["BoundaryEdges"],
+              checks["VolumeBorderEdges"], checks["NonManifoldEdges"], checks["EulerCharacteristic"],
+              "closed" if checks["Closed"] else "not closed"))
+    print("smoothing:  %s, %d iterations (%.3f s with the seam repair)" % (
+        args.smooth, args.iterations, report["repair_seconds"]))
+
     directory = os.path.dirname(os.path.abspath(args.output))
     os.makedirs(directory, exist_ok=True)
-    stl = args.output + ".stl"
-    simple.SaveData(stl, proxy=surface, FileType="Binary")
-    vtp = args.output + ".vtp"
-    write_vtp(surface, vtp)
-    report["outputs"] += [stl, vtp]
+    for extension in args.formats:
+        # The plugin's Merged Surface Writer: one mesh, seam vertices merged, from any rank count.
+        path = args.output + "." + extension
+        simple.SaveData(path, proxy=repaired, FileType="Binary")
+        report["outputs"].append(path)
     if args.screenshot:
-        render(surface, args, ranks)
+        render(repaired, args, ranks)
         report["outputs"].append(args.screenshot)
     with open(args.output + ".json", "w") as out:
         json.dump(report, out, indent=2)

@@ -12,6 +12,7 @@
 // partition planes again and again, two blocks that meet only around the corner where 8 ranks
 // meet, two bars that meet only along the edge where 4 ranks meet, and the CT phantom (with
 // spacing and origin).
+#include "rgmcDistributedData.h"
 #include "rgmcTestData.h"
 
 #include "vtkCallbackCommand.h"
@@ -39,15 +40,13 @@ constexpr int N = 33; // 32 cells per axis: even splits for 2, 4 and 8 ranks
 const int Whole[6] = { 0, N - 1, 0, N - 1, 0, N - 1 };
 const double Pi = 3.14159265358979323846;
 
-using Seeds = std::vector<std::array<double, 3>>;
-
 struct Field
 {
   std::string Name;
   double Isovalue;
   std::vector<Seeds> SeedSets;
   /// The field's samples over a point extent (with its spacing and origin).
-  std::function<vtkSmartPointer<vtkImageData>(const int extent[6])> Make;
+  FieldMaker Make;
 };
 
 Field IndexField(const std::string& name, int type, std::function<double(int, int, int)> f,
@@ -117,116 +116,6 @@ std::vector<Field> Fields()
       return image;
     } });
   return fields;
-}
-
-/// What one rank holds in a decomposition: its owned points (empty box for none) and whether
-/// it gets a ghost layer (as the pipeline gives) or not (a reader that ignores requests).
-struct Piece
-{
-  int Owned[6] = { 0, -1, 0, -1, 0, -1 };
-  bool Ghosts = true;
-  bool Empty() const { return this->Owned[1] < this->Owned[0]; }
-};
-
-std::vector<std::string> Decompositions(int ranks)
-{
-  if (ranks == 1)
-  {
-    return { "block" };
-  }
-  return { "block", "slab-x", "slab-y", "slab-z", "rank0", "empty-rank", "overlap" };
-}
-
-Piece PieceOf(const std::string& how, int rank, int ranks)
-{
-  Piece p;
-  auto block = [&](int piece, int pieces) {
-    vtkNew<vtkExtentTranslator> split;
-    split->PieceToExtentThreadSafe(
-      piece, pieces, 0, const_cast<int*>(Whole), p.Owned, vtkExtentTranslator::BLOCK_MODE, 0);
-  };
-  if (how == "block")
-  {
-    block(rank, ranks);
-  }
-  else if (how.rfind("slab-", 0) == 0)
-  {
-    const int axis = how[5] - 'x';
-    std::copy(Whole, Whole + 6, p.Owned);
-    p.Owned[2 * axis] = (N - 1) * rank / ranks;
-    p.Owned[2 * axis + 1] = (N - 1) * (rank + 1) / ranks;
-  }
-  else if (how == "rank0")
-  {
-    if (rank == 0)
-    {
-      std::copy(Whole, Whole + 6, p.Owned);
-    }
-    p.Ghosts = false;
-  }
-  else if (how == "empty-rank")
-  {
-    const int empty = ranks / 2;
-    if (rank != empty)
-    {
-      block(rank < empty ? rank : rank - 1, ranks - 1);
-    }
-  }
-  else if (how == "overlap")
-  {
-    std::copy(Whole, Whole + 6, p.Owned);
-    p.Ghosts = false;
-  }
-  return p;
-}
-
-vtkSmartPointer<vtkImageData> MakePiece(const Field& field, const Piece& piece)
-{
-  if (piece.Empty())
-  {
-    return vtkSmartPointer<vtkImageData>::New();
-  }
-  int extent[6];
-  WithGhostLayers(piece.Owned, Whole, piece.Ghosts ? 1 : 0, extent);
-  vtkSmartPointer<vtkImageData> image = field.Make(extent);
-  if (piece.Ghosts)
-  {
-    MarkGhostCells(image, piece.Owned);
-  }
-  return image;
-}
-
-struct Run
-{
-  vtkSmartPointer<vtkPolyData> Output;
-  std::string Errors, Warnings;
-};
-
-Run Extract(vtkMultiProcessController* controller, vtkImageData* image, double isovalue,
-  int mode, const Seeds& seeds, const std::function<void(vtkRGMarchingCubes*)>& tweak = nullptr)
-{
-  vtkNew<vtkRGMarchingCubes> rg;
-  vtkNew<MessageCatcher> catcher;
-  catcher->Watch(rg);
-  rg->SetController(controller);
-  rg->SetInputData(image);
-  rg->SetIsovalue(isovalue);
-  rg->SetExtractionMode(mode);
-  for (const auto& s : seeds)
-  {
-    rg->AddSeedPoint(s[0], s[1], s[2]);
-  }
-  if (tweak)
-  {
-    tweak(rg);
-  }
-  rg->Update();
-  Run r;
-  r.Output = vtkSmartPointer<vtkPolyData>::New();
-  r.Output->ShallowCopy(rg->GetOutput());
-  r.Errors = catcher->Errors;
-  r.Warnings = catcher->Warnings;
-  return r;
 }
 
 /// A surface by vertex keys: triangles (sorted key triples) with their ComponentId, and each
@@ -343,7 +232,7 @@ void CollectiveErrors(vtkMultiProcessController* controller)
 {
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
   const Field field = Fields()[0];
-  const Piece piece = PieceOf("block", rank, ranks);
+  const Piece piece = PieceOf("block", Whole, rank, ranks);
   const Seeds seed = field.SeedSets[0];
   auto expect = [&](const std::string& what, const Run& r, const std::string& text, bool error) {
     const std::string message = Text(error ? r.Errors : r.Warnings);
@@ -356,7 +245,7 @@ void CollectiveErrors(vtkMultiProcessController* controller)
 
   // A 3-component array on one rank only.
   {
-    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
     if (rank == ranks - 1)
     {
       vtkNew<vtkFloatArray> vectors;
@@ -371,7 +260,7 @@ void CollectiveErrors(vtkMultiProcessController* controller)
   }
   // NaN samples on the last rank's piece, where the surface passes.
   {
-    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
     if (rank == ranks - 1)
     {
       vtkDataArray* f = image->GetPointData()->GetScalars();
@@ -385,13 +274,13 @@ void CollectiveErrors(vtkMultiProcessController* controller)
   }
   // A seed outside the volume.
   {
-    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
     expect("seed outside", Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::SEEDED,
       { { 16, 16, 90 } }), "lies outside the volume", false);
   }
   // An abort on the last rank only: every rank stops with an empty output.
   {
-    vtkSmartPointer<vtkImageData> image = MakePiece(field, piece);
+    vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
     vtkNew<vtkCallbackCommand> abort;
     abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
       static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
@@ -454,7 +343,7 @@ int main(int argc, char* argv[])
     }
     for (const std::string& how : Decompositions(ranks))
     {
-      vtkSmartPointer<vtkImageData> image = MakePiece(field, PieceOf(how, rank, ranks));
+      vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, PieceOf(how, Whole, rank, ranks));
       std::size_t next = 0;
       for (int mode : modes)
       {

@@ -8,6 +8,7 @@
 import argparse
 import json
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -37,11 +38,23 @@ def stl_triangles(path):
     return count
 
 
+def ply_vertices(path):
+    """The vertex count of a PLY file's header."""
+    with open(path, "rb") as f:
+        for line in f:
+            if line.startswith(b"element vertex"):
+                return int(line.split()[2])
+            if line.startswith(b"end_header"):
+                break
+    return -1
+
+
 def main():
     parser = argparse.ArgumentParser()
     for name in ("--pvbatch", "--script", "--phantom-script", "--plugin", "--workdir"):
         parser.add_argument(name, required=True)
     parser.add_argument("--xvfb-run")
+    parser.add_argument("--admesh")
     args = parser.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
     pipeline = [args.pvbatch, args.script, "--plugin", args.plugin]
@@ -63,7 +76,7 @@ def main():
     result = run(command)
     check(result.returncode == 0, "the pipeline succeeds")
     for expected in ("input:", "72 x 72 x 72", "isovalue:   400", "seed:       (0, 0, 105)",
-                     "triangles", "seconds:"):
+                     "triangles", "seconds:", "mesh:", "closed", "smoothing:  laplacian, 20"):
         check(expected in result.stdout, "the summary says %r" % expected)
     report = json.load(open(prefix + ".json"))
     check(report["triangles"] > 10000, "the skull has many triangles: %d" % report["triangles"])
@@ -73,14 +86,35 @@ def main():
         png = open(prefix + ".png", "rb").read()
         check(png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20000, "a PNG picture is written")
 
-    # The same on 2 ranks (the command starts mpiexec itself): the same surface.
+    checks = report["checks"]
+    check(checks["Closed"] == 1 and checks["BoundaryEdges"] == 0 and checks["NonManifoldEdges"] == 0,
+          "the skull is closed: %s" % checks)
+    check(checks["EulerCharacteristic"] == -6, "the skull (a shell with 5 holes) has Euler "
+          "characteristic -6, not %d" % checks["EulerCharacteristic"])
+
+    # The same on 2 ranks (the command starts mpiexec itself): the same surface, one mesh in
+    # every format.
     result = run(pipeline + ["--input", volume, "--isovalue", "400", "--seed", "0,0,105",
-                             "--output", prefix + "-2", "--ranks", "2"])
+                             "--output", prefix + "-2", "--ranks", "2", "--formats", "stl,ply,vtp"])
     check(result.returncode == 0, "the pipeline succeeds on 2 ranks")
     report2 = json.load(open(prefix + "-2.json"))
     check(report2["ranks"] == 2 and report2["triangles"] == report["triangles"],
           "2 ranks give the same triangles: %d vs %d" % (report2["triangles"], report["triangles"]))
+    check(report2["checks"] == checks, "2 ranks give the same mesh checks: %s" % report2["checks"])
     check(stl_triangles(prefix + "-2.stl") == report["triangles"], "the 2-rank STL holds every triangle")
+    check(ply_vertices(prefix + "-2.ply") == checks["UniquePoints"],
+          "the 2-rank PLY has no duplicate vertex: %d vs %d unique" % (
+              ply_vertices(prefix + "-2.ply"), checks["UniquePoints"]))
+    vtp_header = open(prefix + "-2.vtp", "rb").read(3000).decode("latin-1")
+    check('NumberOfPoints="%d"' % checks["UniquePoints"] in vtp_header,
+          "the 2-rank VTP has no duplicate vertex")
+    if args.admesh:
+        # An independent checker: every edge of the STL joins exactly two facets.
+        out = run([args.admesh, prefix + "-2.stl"]).stdout
+        for line in ("Facets with 1 disconnected edge", "Facets with 2 disconnected edges",
+                     "Facets with 3 disconnected edges"):
+            check(re.search(line + r"\s*:\s*0\s", out) is not None, "admesh: %s is not 0" % line)
+        check(re.search(r"Number of parts\s*:\s*1\s", out) is not None, "admesh: one part")
 
     # Bad input: clear messages and a non-zero exit, nothing written.
     cases = [

@@ -1,0 +1,449 @@
+// vtkRGSeamRepair on 1 rank (vtkDummyController) and under mpiexec. Closed surfaces cut by the
+// partition planes (spheres, one centred where 8 ranks meet; a torus around that corner; the
+// phantom's skull with its holes) must come out closed (no boundary or non-manifold edge) with
+// the expected Euler characteristic, with contiguous global point ids, one owner per vertex,
+// and positions after smoothing identical, to the bit, to the 1-rank result. Windowed sinc must
+// equal vtkWindowedSincPolyDataFilter on the merged mesh. Surfaces without vertex keys (the
+// coordinates fallback, and vtkFlyingEdges3D pieces) must close too. The merged writer's mesh
+// has no duplicate vertex. Bad input gives the same error on every rank.
+#include "rgmcDistributedData.h"
+#include "rgmcTestData.h"
+
+#include "vtkCellArray.h"
+#include "vtkDummyController.h"
+#include "vtkExtractVOI.h"
+#include "vtkFieldData.h"
+#include "vtkFlyingEdges3D.h"
+#include "vtkIdTypeArray.h"
+#include "vtkMPIController.h"
+#include "vtkRGMergedSurfaceWriter.h"
+#include "vtkRGPhantomSource.h"
+#include "vtkRGSeamRepair.h"
+#include "vtkWindowedSincPolyDataFilter.h"
+
+#include <cstring>
+#include <iostream>
+#include <sstream>
+
+using namespace rgmc_test;
+
+namespace
+{
+
+const int Whole[6] = { 0, 64, 0, 64, 0, 64 }; // 64 cells: even splits for 2, 4 and 8 ranks
+const char* MethodNames[] = { "no smoothing", "Laplacian", "windowed sinc" };
+
+struct Surface
+{
+  std::string Name;
+  FieldMaker Make;
+  double Isovalue;
+  int Mode;
+  Seeds SeedPoints;
+  long long Euler;
+};
+
+std::vector<Surface> Surfaces()
+{
+  std::vector<Surface> surfaces;
+  // Five spheres: at the corner where 8 ranks meet, on the middle planes, and inside an octant.
+  const double centres[5][3] = { { 32, 32, 32 }, { 32, 12, 12 }, { 12, 32, 50 }, { 50, 50, 32 },
+    { 12, 12, 12 } };
+  surfaces.push_back(Surface{ "five spheres",
+    [centres](const int extent[6]) {
+      return MakeImage(extent, VTK_DOUBLE, [centres](int i, int j, int k) {
+        double f = -1e9;
+        for (const auto& c : centres)
+        {
+          f = std::max(f, 7.3 - std::sqrt((i - c[0]) * (i - c[0]) + (j - c[1]) * (j - c[1]) +
+                                 (k - c[2]) * (k - c[2])));
+        }
+        return f;
+      });
+    },
+    0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}, 10 });
+  // A torus around the corner where 8 ranks meet.
+  surfaces.push_back(Surface{ "torus",
+    [](const int extent[6]) {
+      return MakeImage(extent, VTK_FLOAT, [](int i, int j, int k) {
+        const double rho = std::sqrt((i - 32.0) * (i - 32.0) + (j - 32.3) * (j - 32.3));
+        return 5.2 - std::sqrt((rho - 14.0) * (rho - 14.0) + (k - 32.4) * (k - 32.4));
+      });
+    },
+    0.0, vtkRGMarchingCubes::SEEDED, { { 46.0, 32.0, 32.0 } }, 0 });
+  // The phantom's skull: a shell with 5 holes (Euler characteristic 4 - 2 * 5).
+  surfaces.push_back(Surface{ "skull",
+    [](const int extent[6]) {
+      vtkNew<vtkRGPhantomSource> phantom;
+      phantom->SetDimensions(65, 65, 65);
+      phantom->UpdateExtent(const_cast<int*>(extent));
+      auto image = vtkSmartPointer<vtkImageData>::New();
+      image->DeepCopy(phantom->GetOutput());
+      image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
+      return image;
+    },
+    400.0, vtkRGMarchingCubes::SEEDED, { { 0, 0, 105 } }, -6 });
+  return surfaces;
+}
+
+struct Repaired
+{
+  vtkSmartPointer<vtkPolyData> Output;
+  std::string Errors;
+};
+
+Repaired Repair(vtkMultiProcessController* controller, vtkPolyData* input, int method)
+{
+  vtkNew<vtkRGSeamRepair> repair;
+  vtkNew<MessageCatcher> catcher;
+  catcher->Watch(repair);
+  repair->SetController(controller);
+  repair->SetInputData(input);
+  repair->SetSmoothingMethod(method);
+  repair->Update();
+  Repaired r;
+  r.Output = vtkSmartPointer<vtkPolyData>::New();
+  r.Output->ShallowCopy(repair->GetOutput());
+  r.Errors = catcher->Errors;
+  return r;
+}
+
+long long Field(vtkPolyData* pd, const char* name)
+{
+  vtkIdTypeArray* a = vtkIdTypeArray::SafeDownCast(pd->GetFieldData()->GetArray(name));
+  return a ? a->GetValue(0) : -1;
+}
+
+/// A repaired surface by global point id: positions and normals as bits, triangles as sorted
+/// id triples, and what the union of pieces must satisfy.
+struct Mesh
+{
+  std::map<long long, std::array<std::uint32_t, 6>> Points;
+  std::set<std::array<long long, 3>> Triangles;
+  std::map<long long, int> Owners; // copies not flagged as duplicates
+  long long Inconsistent = 0, DuplicatedTriangles = 0;
+
+  void Add(vtkPolyData* pd)
+  {
+    if (pd->GetNumberOfPoints() == 0)
+    {
+      return;
+    }
+    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+    vtkDataArray* ghosts = pd->GetPointData()->GetArray(vtkDataSetAttributes::GhostArrayName());
+    vtkDataArray* normals = pd->GetPointData()->GetNormals();
+    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
+    {
+      double x[3], n[3] = { 0, 0, 0 };
+      pd->GetPoint(p, x);
+      if (normals)
+      {
+        normals->GetTuple(p, n);
+      }
+      std::array<std::uint32_t, 6> bits;
+      for (int k = 0; k < 3; ++k)
+      {
+        const float xf = static_cast<float>(x[k]), nf = static_cast<float>(n[k]);
+        std::memcpy(&bits[k], &xf, 4);
+        std::memcpy(&bits[3 + k], &nf, 4);
+      }
+      const long long gid = ids->GetValue(p);
+      auto inserted = this->Points.emplace(gid, bits);
+      this->Inconsistent += !inserted.second && inserted.first->second != bits;
+      this->Owners[gid] += ghosts->GetComponent(p, 0) == 0 ? 1 : 0;
+    }
+    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
+    {
+      vtkIdType npts;
+      const vtkIdType* pts;
+      pd->GetCellPoints(t, npts, pts);
+      std::array<long long, 3> tri = { ids->GetValue(pts[0]), ids->GetValue(pts[1]),
+        ids->GetValue(pts[2]) };
+      std::sort(tri.begin(), tri.end());
+      this->DuplicatedTriangles += !this->Triangles.insert(tri).second;
+    }
+  }
+};
+
+/// Checks on every rank, then the gathered union against the 1-rank mesh.
+void Compare(vtkMultiProcessController* controller, vtkPolyData* piece, const Mesh* reference,
+  long long referenceEuler, const std::string& what)
+{
+  const long long closed = Field(piece, "Closed"), euler = Field(piece, "EulerCharacteristic");
+  RGMC_CHECK(closed == 1, what << ": not closed (" << Field(piece, "BoundaryEdges")
+                               << " boundary, " << Field(piece, "NonManifoldEdges")
+                               << " non-manifold edges)");
+  RGMC_CHECK(euler == referenceEuler, what << ": Euler characteristic " << euler << ", expected "
+                                           << referenceEuler);
+  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
+  controller->Gather(piece, pieces, 0);
+  if (controller->GetLocalProcessId() != 0)
+  {
+    return;
+  }
+  Mesh united;
+  for (auto& p : pieces)
+  {
+    united.Add(vtkPolyData::SafeDownCast(p));
+  }
+  const long long unique = Field(piece, "UniquePoints");
+  RGMC_CHECK(static_cast<long long>(united.Points.size()) == unique &&
+      (united.Points.empty() || united.Points.rbegin()->first == unique - 1),
+    what << ": global ids are not 0.." << unique - 1);
+  long long badOwners = 0;
+  for (const auto& o : united.Owners)
+  {
+    badOwners += o.second != 1;
+  }
+  RGMC_CHECK(badOwners == 0, what << ": " << badOwners << " vertices without exactly one owner");
+  RGMC_CHECK(united.Inconsistent == 0, what << ": " << united.Inconsistent << " copies differ");
+  RGMC_CHECK(united.DuplicatedTriangles == 0, what << ": triangles on two ranks");
+  if (reference)
+  {
+    RGMC_CHECK(united.Triangles == reference->Triangles, what << ": triangles differ from 1 rank");
+    long long differ = 0;
+    for (const auto& p : united.Points)
+    {
+      auto r = reference->Points.find(p.first);
+      differ += r == reference->Points.end() || r->second != p.second;
+    }
+    RGMC_CHECK(differ == 0 && united.Points.size() == reference->Points.size(),
+      what << ": " << differ << " vertices differ from 1 rank (bitwise)");
+  }
+}
+
+/// Windowed sinc on 1 rank against VTK's filter on the merged mesh (points in global-id order).
+void CompareWithVTK(vtkMultiProcessController* single, vtkPolyData* extracted, double spacing,
+  const std::string& name)
+{
+  vtkSmartPointer<vtkPolyData> merged = Repair(single, extracted, vtkRGSeamRepair::NO_SMOOTHING).Output;
+  vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(merged->GetPointData()->GetGlobalIds());
+  for (vtkIdType p = 0; p < merged->GetNumberOfPoints(); ++p)
+  {
+    RGMC_CHECK(ids->GetValue(p) == p, name << ": one rank's points are in global-id order");
+  }
+  vtkNew<vtkPolyData> mesh;
+  mesh->SetPoints(merged->GetPoints());
+  mesh->SetPolys(merged->GetPolys());
+  vtkNew<vtkWindowedSincPolyDataFilter> vtk;
+  vtk->SetInputData(mesh);
+  vtk->Update();
+  vtkSmartPointer<vtkPolyData> ours = Repair(single, extracted, vtkRGSeamRepair::WINDOWED_SINC).Output;
+  double worst = 0;
+  long long bitwise = 0;
+  for (vtkIdType p = 0; p < ours->GetNumberOfPoints(); ++p)
+  {
+    double a[3], b[3];
+    ours->GetPoint(p, a);
+    vtk->GetOutput()->GetPoint(p, b);
+    worst = std::max(worst, std::sqrt(vtkMath::Distance2BetweenPoints(a, b)));
+    bitwise += a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+  }
+  std::cout << name << ": windowed sinc vs vtkWindowedSincPolyDataFilter: max distance "
+            << worst / spacing << " spacings; " << bitwise << " of " << ours->GetNumberOfPoints()
+            << " points identical to the bit\n";
+  RGMC_CHECK(worst <= 1e-5 * spacing, name << ": windowed sinc is " << worst / spacing
+                                           << " spacings from VTK's");
+}
+
+void BadInput(vtkMultiProcessController* controller)
+{
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  auto expect = [&](const std::string& what, vtkPolyData* input, const std::string& text) {
+    const Repaired r = Repair(controller, input, vtkRGSeamRepair::LAPLACIAN);
+    const std::size_t at = r.Errors.find("): ");
+    const std::string message = at == std::string::npos ? r.Errors : r.Errors.substr(at + 3);
+    RGMC_CHECK(message.find(text) != std::string::npos,
+      what << " (rank " << rank << "): expected '" << text << "', got [" << r.Errors << "]");
+    RGMC_CHECK(r.Output->GetNumberOfCells() == 0, what << ": output not empty");
+    long long h = static_cast<long long>(std::hash<std::string>()(message) >> 1), lo, hi;
+    controller->AllReduce(&h, &lo, 1, vtkCommunicator::MIN_OP);
+    controller->AllReduce(&h, &hi, 1, vtkCommunicator::MAX_OP);
+    RGMC_CHECK(lo == hi, what << ": the ranks' messages differ");
+    std::cout << (rank == 0 ? what + ": " + message : std::string());
+  };
+  auto triangle = [](vtkPolyData* pd) {
+    vtkNew<vtkPoints> pts;
+    pts->InsertNextPoint(0, 0, 0);
+    pts->InsertNextPoint(1, 0, 0);
+    pts->InsertNextPoint(0, 1, 0);
+    pts->InsertNextPoint(1, 1, 0);
+    pd->SetPoints(pts);
+    vtkNew<vtkCellArray> polys;
+    const vtkIdType tri[3] = { 0, 1, 2 };
+    polys->InsertNextCell(3, tri);
+    pd->SetPolys(polys);
+  };
+  {
+    vtkNew<vtkPolyData> lines;
+    triangle(lines);
+    lines->SetPolys(nullptr);
+    vtkNew<vtkCellArray> cells;
+    const vtkIdType line[3] = { 0, 1, 2 };
+    cells->InsertNextCell(3, line);
+    lines->SetLines(cells);
+    expect("lines only", lines, "not a triangle mesh");
+  }
+  {
+    vtkNew<vtkPolyData> mixed;
+    triangle(mixed);
+    if (rank == ranks - 1)
+    {
+      vtkNew<vtkCellArray> cells;
+      const vtkIdType line[2] = { 0, 3 };
+      cells->InsertNextCell(2, line);
+      mixed->SetLines(cells);
+    }
+    expect("a line among the triangles of the last rank", mixed, "1 lines");
+  }
+  {
+    vtkNew<vtkPolyData> quad;
+    triangle(quad);
+    if (rank == 0)
+    {
+      const vtkIdType q[4] = { 0, 1, 3, 2 };
+      quad->GetPolys()->InsertNextCell(4, q);
+    }
+    expect("a quad on rank 0", quad, "1 polygons that are not triangles");
+  }
+  {
+    vtkNew<vtkPolyData> empty;
+    expect("nothing on any rank", empty, "no triangles");
+  }
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  const bool dummy = argc > 1 && std::string(argv[1]) == "--dummy";
+  vtkSmartPointer<vtkMultiProcessController> controller;
+  if (dummy)
+  {
+    controller = vtkSmartPointer<vtkDummyController>::New();
+  }
+  else
+  {
+    controller = vtkSmartPointer<vtkMPIController>::New();
+  }
+  controller->Initialize(&argc, &argv);
+  vtkMultiProcessController::SetGlobalController(controller);
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  vtkNew<vtkDummyController> single;
+
+  for (const Surface& surface : Surfaces())
+  {
+    // 1-rank references, each smoothing method, with vertex keys and without.
+    std::vector<Mesh> references(6);
+    double spacing = 1.0;
+    if (rank == 0)
+    {
+      vtkSmartPointer<vtkImageData> whole = surface.Make(Whole);
+      spacing = whole->GetSpacing()[0];
+      vtkSmartPointer<vtkPolyData> extracted =
+        Extract(single, whole, surface.Isovalue, surface.Mode, surface.SeedPoints).Output;
+      vtkNew<vtkPolyData> unkeyed;
+      unkeyed->ShallowCopy(extracted);
+      unkeyed->GetPointData()->SetGlobalIds(nullptr);
+      for (int method = 0; method < 3; ++method)
+      {
+        for (int keyed = 0; keyed < 2; ++keyed)
+        {
+          Repaired r = Repair(single, keyed ? extracted.Get() : unkeyed.Get(), method);
+          RGMC_CHECK(r.Errors.empty(), surface.Name << ": " << r.Errors);
+          RGMC_CHECK(Field(r.Output, "Closed") == 1, surface.Name << " on 1 rank is not closed");
+          RGMC_CHECK(Field(r.Output, "EulerCharacteristic") == surface.Euler,
+            surface.Name << " on 1 rank: Euler characteristic " << Field(r.Output, "EulerCharacteristic"));
+          references[2 * method + keyed].Add(r.Output);
+        }
+      }
+      CompareWithVTK(single, extracted, spacing, surface.Name);
+    }
+
+    for (const std::string& how : Decompositions(ranks))
+    {
+      vtkSmartPointer<vtkImageData> image =
+        MakePiece(surface.Make, Whole, PieceOf(how, Whole, rank, ranks));
+      vtkSmartPointer<vtkPolyData> extracted =
+        Extract(controller, image, surface.Isovalue, surface.Mode, surface.SeedPoints).Output;
+      vtkNew<vtkPolyData> unkeyed;
+      unkeyed->ShallowCopy(extracted);
+      unkeyed->GetPointData()->SetGlobalIds(nullptr);
+      for (int method = 0; method < 3; ++method)
+      {
+        for (int keyed = 0; keyed < 2; ++keyed)
+        {
+          std::ostringstream what;
+          what << surface.Name << ", " << how << " on " << ranks << " ranks, "
+               << MethodNames[method] << (keyed ? "" : ", by coordinates");
+          Repaired r = Repair(controller, keyed ? extracted.Get() : unkeyed.Get(), method);
+          RGMC_CHECK(r.Errors.empty(), what.str() << ": " << r.Errors);
+          Compare(controller, r.Output, rank == 0 ? &references[2 * method + keyed] : nullptr,
+            surface.Euler, what.str());
+        }
+      }
+    }
+
+    // Any distributed surface: vtkFlyingEdges3D on each rank's own cells, matched by
+    // coordinates (its seam vertices are computed alike on both sides).
+    {
+      const Piece piece = PieceOf("block", Whole, rank, ranks);
+      vtkSmartPointer<vtkImageData> image = MakePiece(surface.Make, Whole, piece);
+      vtkNew<vtkPolyData> surfacePiece;
+      if (!piece.Empty())
+      {
+        vtkNew<vtkExtractVOI> own;
+        own->SetInputData(image);
+        own->SetVOI(const_cast<int*>(piece.Owned));
+        vtkNew<vtkFlyingEdges3D> fe;
+        fe->SetInputConnection(own->GetOutputPort());
+        fe->SetValue(0, surface.Isovalue);
+        fe->Update();
+        surfacePiece->ShallowCopy(fe->GetOutput());
+      }
+      Repaired r = Repair(controller, surfacePiece, vtkRGSeamRepair::LAPLACIAN);
+      const long long border = Field(r.Output, "VolumeBorderEdges");
+      const long long boundary = Field(r.Output, "BoundaryEdges");
+      const long long nonManifold = Field(r.Output, "NonManifoldEdges");
+      // vtkFlyingEdges3D keeps every component and zero-area triangles; what matters here is
+      // that the seams close: no boundary edge.
+      RGMC_CHECK(boundary == 0, surface.Name << ", vtkFlyingEdges3D pieces on " << ranks
+                                             << " ranks: " << boundary << " boundary edges");
+      if (rank == 0)
+      {
+        std::cout << surface.Name << ", vtkFlyingEdges3D pieces: " << boundary << " boundary, "
+                  << border << " border, " << nonManifold << " non-manifold edges\n";
+      }
+    }
+
+    // The merged writer's mesh: every vertex once.
+    {
+      vtkSmartPointer<vtkImageData> image =
+        MakePiece(surface.Make, Whole, PieceOf("block", Whole, rank, ranks));
+      vtkSmartPointer<vtkPolyData> extracted =
+        Extract(controller, image, surface.Isovalue, surface.Mode, surface.SeedPoints).Output;
+      Repaired r = Repair(controller, extracted, vtkRGSeamRepair::LAPLACIAN);
+      std::vector<vtkSmartPointer<vtkDataObject>> pieces;
+      controller->Gather(r.Output, pieces, 0);
+      if (rank == 0)
+      {
+        vtkSmartPointer<vtkPolyData> merged = vtkRGMergedSurfaceWriter::Merge(pieces);
+        RGMC_CHECK(merged->GetNumberOfPoints() == Field(r.Output, "UniquePoints"),
+          surface.Name << ": the merged mesh has " << merged->GetNumberOfPoints() << " points, not "
+                       << Field(r.Output, "UniquePoints"));
+        RGMC_CHECK(merged->GetNumberOfCells() == Field(r.Output, "Triangles"),
+          surface.Name << ": the merged mesh lost triangles");
+      }
+    }
+  }
+  BadInput(controller);
+
+  long long failures = rgmc_test::Failures(), total = 0;
+  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
+  if (rank == 0)
+  {
+    std::cout << "TestSeamRepair on " << ranks << " ranks: " << total << " failed checks\n";
+  }
+  controller->Finalize();
+  return total == 0 ? 0 : 1;
+}

@@ -1,0 +1,134 @@
+// Decompositions of a volume over ranks, as the pipeline and readers make them, for the
+// distributed tests; and running vtkRGMarchingCubes on one rank's piece.
+#ifndef rgmcDistributedData_h
+#define rgmcDistributedData_h
+
+#include "rgmcTestData.h"
+
+#include "vtkExtentTranslator.h"
+#include "vtkMultiProcessController.h"
+#include "vtkRGMarchingCubes.h"
+
+namespace rgmc_test
+{
+
+using Seeds = std::vector<std::array<double, 3>>;
+/// Samples of a field over a point extent (with the field's spacing and origin).
+using FieldMaker = std::function<vtkSmartPointer<vtkImageData>(const int extent[6])>;
+
+/// What one rank holds in a decomposition: its owned points (empty box for none) and whether
+/// it gets a ghost layer (as the pipeline gives) or not (a reader that ignores requests).
+struct Piece
+{
+  int Owned[6] = { 0, -1, 0, -1, 0, -1 };
+  bool Ghosts = true;
+  bool Empty() const { return this->Owned[1] < this->Owned[0]; }
+};
+
+inline std::vector<std::string> Decompositions(int ranks)
+{
+  if (ranks == 1)
+  {
+    return { "block" };
+  }
+  return { "block", "slab-x", "slab-y", "slab-z", "rank0", "empty-rank", "overlap" };
+}
+
+/// This rank's piece of `whole` (a point extent with the same number of cells on each axis).
+inline Piece PieceOf(const std::string& how, const int whole[6], int rank, int ranks)
+{
+  const int cells = whole[1] - whole[0];
+  Piece p;
+  auto block = [&](int piece, int pieces) {
+    vtkNew<vtkExtentTranslator> split;
+    split->PieceToExtentThreadSafe(
+      piece, pieces, 0, const_cast<int*>(whole), p.Owned, vtkExtentTranslator::BLOCK_MODE, 0);
+  };
+  if (how == "block")
+  {
+    block(rank, ranks);
+  }
+  else if (how.rfind("slab-", 0) == 0)
+  {
+    const int axis = how[5] - 'x';
+    std::copy(whole, whole + 6, p.Owned);
+    p.Owned[2 * axis] = whole[2 * axis] + cells * rank / ranks;
+    p.Owned[2 * axis + 1] = whole[2 * axis] + cells * (rank + 1) / ranks;
+  }
+  else if (how == "rank0")
+  {
+    if (rank == 0)
+    {
+      std::copy(whole, whole + 6, p.Owned);
+    }
+    p.Ghosts = false;
+  }
+  else if (how == "empty-rank")
+  {
+    const int empty = ranks / 2;
+    if (rank != empty)
+    {
+      block(rank < empty ? rank : rank - 1, ranks - 1);
+    }
+  }
+  else if (how == "overlap")
+  {
+    std::copy(whole, whole + 6, p.Owned);
+    p.Ghosts = false;
+  }
+  return p;
+}
+
+inline vtkSmartPointer<vtkImageData> MakePiece(
+  const FieldMaker& make, const int whole[6], const Piece& piece)
+{
+  if (piece.Empty())
+  {
+    return vtkSmartPointer<vtkImageData>::New();
+  }
+  int extent[6];
+  WithGhostLayers(piece.Owned, whole, piece.Ghosts ? 1 : 0, extent);
+  vtkSmartPointer<vtkImageData> image = make(extent);
+  if (piece.Ghosts)
+  {
+    MarkGhostCells(image, piece.Owned);
+  }
+  return image;
+}
+
+struct Run
+{
+  vtkSmartPointer<vtkPolyData> Output;
+  std::string Errors, Warnings;
+};
+
+inline Run Extract(vtkMultiProcessController* controller, vtkImageData* image, double isovalue,
+  int mode, const Seeds& seeds, const std::function<void(vtkRGMarchingCubes*)>& tweak = nullptr)
+{
+  vtkNew<vtkRGMarchingCubes> rg;
+  vtkNew<MessageCatcher> catcher;
+  catcher->Watch(rg);
+  rg->SetController(controller);
+  rg->SetInputData(image);
+  rg->SetIsovalue(isovalue);
+  rg->SetExtractionMode(mode);
+  for (const auto& s : seeds)
+  {
+    rg->AddSeedPoint(s[0], s[1], s[2]);
+  }
+  if (tweak)
+  {
+    tweak(rg);
+  }
+  rg->Update();
+  Run r;
+  r.Output = vtkSmartPointer<vtkPolyData>::New();
+  r.Output->ShallowCopy(rg->GetOutput());
+  r.Errors = catcher->Errors;
+  r.Warnings = catcher->Warnings;
+  return r;
+}
+
+} // namespace rgmc_test
+
+#endif
