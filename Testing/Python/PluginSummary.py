@@ -8,6 +8,7 @@ the first rank) to JSON, so that runs on different rank counts can be compared e
 import argparse
 import hashlib
 import json
+import os
 import struct
 
 from paraview import servermanager, simple
@@ -43,6 +44,32 @@ def summary(polydata):
     }
 
 
+def repaired_summary(polydata):
+    """The repaired mesh by global point id: positions and normals (float bits), triangles as
+    sorted id triples; copies of a vertex must agree, and exactly one must be its owner."""
+    ids = polydata.GetPointData().GetArray("GlobalPointIds")
+    ghosts = polydata.GetPointData().GetArray("vtkGhostType")
+    normals = polydata.GetPointData().GetNormals()
+    vertices, owners = {}, {}
+    for p in range(polydata.GetNumberOfPoints()):
+        bits = struct.pack("<6f", *(polydata.GetPoint(p) + normals.GetTuple3(p)))
+        gid = ids.GetValue(p)
+        if vertices.setdefault(gid, bits) != bits:
+            raise RuntimeError("the copies of vertex %d differ" % gid)
+        owners[gid] = owners.get(gid, 0) + (ghosts.GetValue(p) == 0)
+    if any(count != 1 for count in owners.values()):
+        raise RuntimeError("a vertex has not exactly one owner")
+    triangles = sorted(tuple(sorted(ids.GetValue(polydata.GetCell(t).GetPointId(v)) for v in range(3)))
+                       for t in range(polydata.GetNumberOfCells()))
+    digest = hashlib.sha256()
+    for gid in sorted(vertices):
+        digest.update(struct.pack("<q", gid) + vertices[gid])
+    for tri in triangles:
+        digest.update(struct.pack("<3q", *tri))
+    return {"vertices": len(vertices), "max_gid": max(vertices), "triangles": len(triangles),
+            "digest": digest.hexdigest()}
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--plugin", required=True)
@@ -71,6 +98,23 @@ def main():
         results[name] = summary(servermanager.Fetch(surface))
         results[name]["number_of_triangles_field"] = [int(low), int(high)]
         simple.Delete(surface)
+    # Seam repair and smoothing through the proxies, and the merged writer.
+    skull = RGMarchingCubes(Input=phantom, ContourBy=["POINTS", "HU"], Isovalue=400,  # noqa: F821
+                            SeedPoints=[0, 0, 105])
+    for method in ("Laplacian", "Windowed Sinc"):
+        repaired = RGSeamRepair(Input=skull, SmoothingMethod=method)  # noqa: F821
+        repaired.UpdatePipeline()
+        data_information = repaired.GetDataInformation()  # keep it alive while reading it
+        info = data_information.DataInformation.GetFieldDataInformation()
+        checks = {name: int(info.GetArrayInformation(name).GetComponentRange(0)[0])
+                  for name in ("UniquePoints", "Closed", "EulerCharacteristic")}
+        summary_ = repaired_summary(servermanager.Fetch(repaired))
+        summary_.update(checks)
+        ply = os.path.splitext(args.output)[0] + "-" + method.replace(" ", "") + ".ply"
+        simple.SaveData(ply, proxy=repaired)
+        with open(ply, "rb") as f:
+            summary_["ply_vertices"] = next(int(l.split()[2]) for l in f if l.startswith(b"element vertex"))
+        results["repaired " + method] = summary_
     with open(args.output, "w") as out:
         json.dump(results, out, indent=1)
     print("summary written to %s on %d ranks" % (args.output, ranks))

@@ -60,6 +60,19 @@ def main():
                 print("FAILED: %s on %d ranks: only ranks %s made triangles" % (
                     run, ranks, ours["ranks_with_triangles"]), file=sys.stderr)
                 failures += 1
+        for run in ("repaired Laplacian", "repaired Windowed Sinc"):
+            ours, theirs = summary[run], reference[run]
+            if ours != theirs:
+                print("FAILED: %s on %d ranks differs from 1 rank: %s vs %s" % (run, ranks, ours, theirs),
+                      file=sys.stderr)
+                failures += 1
+            if ours["Closed"] != 1 or ours["EulerCharacteristic"] != -6:
+                print("FAILED: %s on %d ranks: not a closed skull: %s" % (run, ranks, ours), file=sys.stderr)
+                failures += 1
+            if not (ours["ply_vertices"] == ours["UniquePoints"] == ours["vertices"] == ours["max_gid"] + 1):
+                print("FAILED: %s on %d ranks: PLY vertices %d, unique points %d, global ids %d" % (
+                    run, ranks, ours["ply_vertices"], ours["UniquePoints"], ours["vertices"]), file=sys.stderr)
+                failures += 1
     if failures:
         return 1
     print("TestPluginMPI: runs on %s ranks equal the 1-rank run exactly" % sorted(summaries))
