@@ -135,6 +135,9 @@ def main(argv):
         print("note: running on %d MPI ranks (--ranks %d)" % (ranks, args.ranks))
 
     from paraview import simple
+    from vtkmodules.vtkCommonCore import vtkLogger
+    # The command prints the seam repair's checks itself; its log line would say them twice.
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_WARNING)
     rgmc_common.load_plugin(args.plugin)
 
     started = time.time()
