@@ -1023,8 +1023,9 @@ int vtkRGMarchingCubes::RequestData(
   }
   output->GetPointData()->SetGlobalIds(keys);
   output->GetCellData()->AddArray(rankIds);
+  // No active scalars: ParaView shows the surface in one colour, as Contour's; colouring by
+  // RankId (the decomposition) or ComponentId is the user's choice.
   output->GetCellData()->AddArray(componentIds);
-  output->GetCellData()->SetActiveScalars("ComponentId");
 
   vtkNew<vtkIdTypeArray> seedKeyArray;
   seedKeyArray->SetName("SeedVertexKeys");

@@ -103,7 +103,8 @@ def render(source, args, ranks):
         pass
     display = simple.Show(source, view)
     if args.color_by == "solid":
-        simple.ColorBy(display, None)
+        if display.ColorArrayName[1]:
+            simple.ColorBy(display, None)
         display.DiffuseColor = [0.93, 0.89, 0.80]
         display.AmbientColor = [0.93, 0.89, 0.80]
     else:
