@@ -28,23 +28,71 @@ def find_plugin(explicit=None):
     return None
 
 
-def load_plugin(explicit=None):
+def connect(address):
+    """Connects this pvpython to a running pvserver (HOST:PORT or cs://HOST:PORT): the pipeline
+    then runs on the server's ranks, on ParaView's decomposition there."""
+    from paraview import servermanager, simple
+    text = address[len("cs://"):] if address.startswith("cs://") else address
+    host, _, port = text.rpartition(":")
+    try:
+        port = int(port)
+    except ValueError:
+        host = ""
+    if not host:
+        raise UsageError("--connect expects HOST:PORT (a pvserver's address), not %r" % address)
+    try:
+        connection = simple.Connect(host, port)
+    except Exception as error:  # ParaView raises RuntimeError; be as clear for any other
+        connection, message = None, str(error)
+    else:
+        message = "no server answered"
+    if connection is None or servermanager.ActiveConnection is None:
+        raise UsageError("cannot connect to a pvserver at %s:%d (%s): start one with "
+                         "`mpiexec -n N pvserver --server-port=%d` there" % (host, port, message, port))
+
+
+def is_client():
+    """Whether this ParaView is a client connected to a separate pvserver."""
+    from paraview import servermanager
+    return servermanager.ActiveConnection is not None and servermanager.ActiveConnection.IsRemote()
+
+
+def load_plugin(explicit=None, server_path=None):
     """Loads the plugin into ParaView and adds its proxies (RGMarchingCubes, CTPhantom, ...) to
-    paraview.simple. A plugin already loaded (auto-loaded from PV_PLUGIN_PATH) is used as is."""
+    paraview.simple. A plugin already loaded (auto-loaded from PV_PLUGIN_PATH) is used as is.
+    Connected to a pvserver, the plugin is loaded on the client and on the server (from
+    `server_path`, a path on the server's machine, by default the client's path)."""
     from paraview import simple
-    if hasattr(simple, "RGMarchingCubes") and not explicit:
-        return None
+    if not is_client():
+        if hasattr(simple, "RGMarchingCubes") and not explicit:
+            return None
+        path = find_plugin(explicit)
+        if path is None:
+            raise UsageError("cannot find the RGMarchingCubes plugin: build it (./rgmc build), "
+                             "or pass --plugin PATH, or set RGMC_PLUGIN")
+        simple.LoadPlugin(path, ns=vars(simple))
+        return path
     path = find_plugin(explicit)
-    if path is None:
-        raise UsageError("cannot find the RGMarchingCubes plugin: build it (./rgmc build), "
-                         "or pass --plugin PATH, or set RGMC_PLUGIN")
-    simple.LoadPlugin(path, ns=vars(simple))
-    return path
+    if path:
+        simple.LoadPlugin(path, remote=False, ns=vars(simple))
+    server_path = server_path or path
+    if not server_path:
+        raise UsageError("give the plugin's path on the server with --server-plugin PATH")
+    try:
+        simple.LoadPlugin(server_path, remote=True, ns=vars(simple))
+    except RuntimeError:
+        raise UsageError(
+            "the server cannot load the RGMC plugin from %s (its message is above): build and "
+            "install the plugin on the server's machine against the server's ParaView (README: "
+            "Running on a cluster) and give its path there with --server-plugin" % server_path)
+    return server_path
 
 
 def number_of_ranks():
-    """How many MPI ranks this pvbatch runs on."""
+    """How many MPI ranks the pipeline runs on: this pvbatch's, or the connected pvserver's."""
     from paraview import servermanager
+    if is_client():
+        return servermanager.ActiveConnection.GetNumberOfDataPartitions()
     return servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
 
 
@@ -103,7 +151,7 @@ def open_volume(spec):
             raise UsageError("phantom:N or phantom:NX,NY,NZ expects sizes of at least 2, not %r"
                              % spec)
         return simple.CTPhantom(Dimensions=dims)
-    if not os.path.exists(spec):
+    if not is_client() and not os.path.exists(spec):  # a server reads its own file system
         raise UsageError("no such file or directory: %s" % spec)
     source = simple.OpenDataFile(spec)
     if source is None:

@@ -77,11 +77,20 @@ def parse_args(argv):
                         help="number of MPI ranks (default 1); the command re-runs itself "
                         "under mpiexec when it is not already running on that many")
     parser.add_argument("--plugin", help="the plugin library (default: found in build/)")
+    parser.add_argument("--connect", metavar="HOST:PORT",
+                        help="run on a pvserver (e.g. mpiexec -n 8 pvserver on a cluster) instead "
+                        "of here: run this command with pvpython; the server reads --input and "
+                        "writes the surface files on its own file system")
+    parser.add_argument("--server-plugin", metavar="PATH",
+                        help="with --connect: the plugin library's path on the server (default: "
+                        "the --plugin path)")
     args = parser.parse_args(argv)
     if args.mode == "seeded" and not args.seed:
         parser.error("the seeded mode needs at least one --seed x,y,z")
     if args.ranks < 1:
         parser.error("--ranks must be at least 1")
+    if args.connect and args.ranks != 1:
+        parser.error("--ranks is for pvbatch here; with --connect the server's ranks are used")
     if args.iterations < 0:
         parser.error("--iterations must be at least 0")
     args.formats = [f.strip().lower() for f in args.formats.split(",") if f.strip()]
@@ -128,18 +137,21 @@ def render(source, args, ranks):
 
 def main(argv):
     args = parse_args(argv)
+    if args.connect:
+        rgmc_common.connect(args.connect)
     ranks = rgmc_common.number_of_ranks()
-    if args.ranks > 1 and ranks == 1:
-        return rgmc_common.relaunch(os.path.abspath(__file__), argv, args.ranks,
-                                    render=bool(args.screenshot))
-    if ranks != args.ranks:
-        print("note: running on %d MPI ranks (--ranks %d)" % (ranks, args.ranks))
+    if not args.connect:
+        if args.ranks > 1 and ranks == 1:
+            return rgmc_common.relaunch(os.path.abspath(__file__), argv, args.ranks,
+                                        render=bool(args.screenshot))
+        if ranks != args.ranks:
+            print("note: running on %d MPI ranks (--ranks %d)" % (ranks, args.ranks))
 
     from paraview import simple
     from vtkmodules.vtkCommonCore import vtkLogger
     # The command prints the seam repair's checks itself; its log line would say them twice.
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_WARNING)
-    rgmc_common.load_plugin(args.plugin)
+    rgmc_common.load_plugin(args.plugin, args.server_plugin)
 
     started = time.time()
     volume = rgmc_common.open_volume(args.input)
@@ -188,7 +200,8 @@ def main(argv):
     }
     print("input:      %s (%d x %d x %d, array %s, range %g to %g)" % (
         args.input, dims[0], dims[1], dims[2], array, value_range[0], value_range[1]))
-    print("isovalue:   %g   mode: %s   ranks: %d" % (args.isovalue, args.mode, ranks))
+    print("isovalue:   %g   mode: %s   ranks: %d%s" % (
+        args.isovalue, args.mode, ranks, " (pvserver at %s)" % args.connect if args.connect else ""))
     for seed in args.seed:
         print("seed:       (%g, %g, %g)" % tuple(seed))
     print("surface:    %d triangles" % triangles)

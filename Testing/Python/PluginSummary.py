@@ -1,8 +1,10 @@
-"""pvbatch script (serial or under mpiexec): runs the plugin's filter through its proxy on
-ParaView's own decomposition of the CT phantom and writes a summary of the result (gathered on
-the first rank) to JSON, so that runs on different rank counts can be compared exactly.
+"""pvbatch script (serial or under mpiexec), or pvpython client of a pvserver: runs the plugin's
+filters through their proxies on ParaView's own decomposition of the CT phantom and writes a
+summary of the results (gathered on the first rank, or fetched to the client) to JSON, so that
+runs on different rank counts, and in client-server mode, can be compared exactly.
 
   [mpiexec -n N] pvbatch [--mpi] PluginSummary.py --plugin RGMarchingCubes.so --output s.json
+  pvpython PluginSummary.py --connect HOST:PORT --plugin RGMarchingCubes.so --output s.json
 """
 
 import argparse
@@ -74,9 +76,19 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--plugin", required=True)
     parser.add_argument("--output", required=True)
+    parser.add_argument("--connect", help="HOST:PORT of a pvserver to run on")
     args = parser.parse_args()
-    simple.LoadPlugin(args.plugin, ns=globals())
-    ranks = servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
+    if args.connect:
+        host, port = args.connect.rsplit(":", 1)
+        if simple.Connect(host, int(port)) is None:
+            raise RuntimeError("cannot connect to %s" % args.connect)
+        # On the client (its GUI parts, if any) and on the server (the filters).
+        simple.LoadPlugin(args.plugin, remote=False, ns=globals())
+        simple.LoadPlugin(args.plugin, remote=True, ns=globals())
+        ranks = servermanager.ActiveConnection.GetNumberOfDataPartitions()
+    else:
+        simple.LoadPlugin(args.plugin, ns=globals())
+        ranks = servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
 
     phantom = CTPhantom(Dimensions=[64, 64, 64])  # noqa: F821 (defined by the plugin)
     results = {"ranks": ranks}
@@ -117,7 +129,7 @@ def main():
         results["repaired " + method] = summary_
     with open(args.output, "w") as out:
         json.dump(results, out, indent=1)
-    print("summary written to %s on %d ranks" % (args.output, ranks))
+    print("summary written to %s on %d ranks%s" % (args.output, ranks, " of a pvserver" if args.connect else ""))
 
 
 main()

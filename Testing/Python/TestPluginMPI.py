@@ -11,6 +11,8 @@ import os
 import subprocess
 import sys
 
+import SummaryCompare
+
 
 def main():
     parser = argparse.ArgumentParser()
@@ -39,40 +41,11 @@ def main():
             return 1
         summaries[ranks] = json.load(open(output))
 
-    failures = 0
-    reference = summaries[1]
+    failures = []
     for ranks, summary in summaries.items():
-        if summary["ranks"] != ranks:
-            print("FAILED: pvbatch ran on %d ranks, not %d" % (summary["ranks"], ranks), file=sys.stderr)
-            failures += 1
-        for run in ("skull", "skull+jaw+vertebra", "largest", "all"):
-            ours, theirs = summary[run], reference[run]
-            for field in ("triangles", "vertices", "digest", "number_of_triangles_field"):
-                if ours[field] != theirs[field]:
-                    print("FAILED: %s on %d ranks: %s %s, on 1 rank %s" % (
-                        run, ranks, field, ours[field], theirs[field]), file=sys.stderr)
-                    failures += 1
-            if ours["number_of_triangles_field"] != [theirs["triangles"]] * 2:
-                print("FAILED: %s on %d ranks: NumberOfTriangles %s" % (
-                    run, ranks, ours["number_of_triangles_field"]), file=sys.stderr)
-                failures += 1
-            if ranks > 1 and len(ours["ranks_with_triangles"]) < 2:
-                print("FAILED: %s on %d ranks: only ranks %s made triangles" % (
-                    run, ranks, ours["ranks_with_triangles"]), file=sys.stderr)
-                failures += 1
-        for run in ("repaired Laplacian", "repaired Windowed Sinc"):
-            ours, theirs = summary[run], reference[run]
-            if ours != theirs:
-                print("FAILED: %s on %d ranks differs from 1 rank: %s vs %s" % (run, ranks, ours, theirs),
-                      file=sys.stderr)
-                failures += 1
-            if ours["Closed"] != 1 or ours["EulerCharacteristic"] != -6:
-                print("FAILED: %s on %d ranks: not a closed skull: %s" % (run, ranks, ours), file=sys.stderr)
-                failures += 1
-            if not (ours["ply_vertices"] == ours["UniquePoints"] == ours["vertices"] == ours["max_gid"] + 1):
-                print("FAILED: %s on %d ranks: PLY vertices %d, unique points %d, global ids %d" % (
-                    run, ranks, ours["ply_vertices"], ours["UniquePoints"], ours["vertices"]), file=sys.stderr)
-                failures += 1
+        failures += SummaryCompare.compare(summary, summaries[1], ranks, "pvbatch on %d ranks" % ranks)
+    for failure in failures:
+        print("FAILED: " + failure, file=sys.stderr)
     if failures:
         return 1
     print("TestPluginMPI: runs on %s ranks equal the 1-rank run exactly" % sorted(summaries))
