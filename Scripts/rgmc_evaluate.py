@@ -1,0 +1,314 @@
+"""RGMC's evaluation (not a test): the paper's tables, reproduced on this machine, in one run.
+
+  python3 Scripts/rgmc_evaluate.py            # or: ./rgmc evaluate
+
+Starts the build's rgmcEvaluation program once under mpiexec (one process set: as many
+processes as the largest rank count; the smaller rank counts run on the first processes while
+the others sleep), which measures, for each case (the CT phantom at 256^3 and 512^3, one small
+sphere in 512^3 of empty space, a many-blob field, a real MRI from Debian's mricron-data when
+installed), vtkMarchingCubes (the paper's MC), our seeded mode on 1 rank (the paper's RGMC) and
+on more (its parallel method), ParaView's Contour, vtkFlyingEdges3D, Contour + Connectivity
+(the pipeline that gives the same surface in ParaView today), seam repair with smoothing and
+ParaView's Smooth: triangles, seconds (min and median of the repeats; a run's time is its
+slowest rank's), peak memory per rank; the Hausdorff distances between the N-rank and 1-rank
+surfaces and between our smoothing and VTK's; and the time against the volume's size for the
+same sphere in 128^3 to 1024^3 of empty space. Writes report.md, results.json and PNG plots
+under build/evaluation/. Ranks above the core count are oversubscribed and marked so.
+"""
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rgmc_common  # noqa: E402
+
+METHODS = ["mc", "seeded", "fe", "contour", "contour+connectivity", "repair", "smooth"]
+NAMES = {
+    "mc": "vtkMarchingCubes (the paper's MC)",
+    "seeded": "**RGMC seeded (ours)**",
+    "fe": "vtkFlyingEdges3D",
+    "contour": "ParaView Contour",
+    "contour+connectivity": "Contour + Connectivity",
+    "repair": "**Seam Repair + 20 Laplacian (ours)**",
+    "smooth": "ParaView Smooth, 20 it. (per piece)",
+}
+CASES = {
+    "phantom256": "CT phantom 256^3, skull from one seed (400 HU)",
+    "phantom512": "CT phantom 512^3, skull from one seed (400 HU)",
+    "sphere512": "One small sphere (radius 12 voxels) in 512^3 of empty space",
+    "blobs": "Many blobs (2048 Gaussian bumps in 256^3), one component from one seed",
+    "mri": "Real MRI: Colin 27 T1 head (mricron-data ch2.nii.gz, 181x217x181), head surface",
+}
+
+
+def machine():
+    cpu = "unknown CPU"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    memory = ""
+    try:
+        kib = int(open("/proc/meminfo").readline().split()[1])
+        memory = ", %.0f GiB" % (kib / 1024 / 1024)
+    except (OSError, ValueError, IndexError):
+        pass
+    return "%s, %d cores%s, %s" % (cpu, os.cpu_count(), memory, platform.platform())
+
+
+def run(args):
+    processes = max(args.ranks)
+    command = rgmc_common.mpiexec_command(processes) + [
+        args.binary, "--cases", ",".join(args.cases), "--ranks", ",".join(map(str, args.ranks)),
+        "--sweep", ",".join(map(str, args.sweep)), "--repeats", str(args.repeats),
+        "--sweep-repeats", str(args.sweep_repeats), "--mri", args.mri]
+    if args.quick:
+        command.append("--quick")
+    print("+ " + " ".join(command), flush=True)
+    rows = []
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, env=rgmc_common.mpi_environment())
+    for line in process.stdout:
+        if not line.startswith("{"):
+            continue
+        row = json.loads(line)
+        rows.append(row)
+        if "method" in row:
+            print("  %-18s %d rank%s%s %-22s %9.4f s (median %9.4f)  %9d triangles  %7.0f MiB" % (
+                row["case"], row["ranks"], "s" if row["ranks"] > 1 else " ",
+                "*" if row["oversubscribed"] else " ", row["method"], row["min_seconds"],
+                row["median_seconds"], row["triangles"], row["peak_rss_mib"] or 0), flush=True)
+        elif "distance" in row:
+            print("  %-18s %d rank%s  Hausdorff %-70s %.3g" % (
+                row["case"], row["ranks"], "s" if row["ranks"] > 1 else " ", row["distance"],
+                row["hausdorff"]), flush=True)
+        elif "skipped" in row:
+            print("  skipped %s: %s" % (row["skipped"], row["why"]), flush=True)
+    if process.wait() != 0:
+        raise rgmc_common.UsageError("the evaluation program failed (status %d)" % process.returncode)
+    return rows
+
+
+def find(rows, case, ranks, method):
+    for row in rows:
+        if row.get("case") == case and row.get("ranks") == ranks and row.get("method") == method:
+            return row
+    return None
+
+
+def seconds(row):
+    return "%.4f (%.4f)" % (row["min_seconds"], row["median_seconds"]) if row else "-"
+
+
+def targets(rows, args):
+    """The issue's targets, each with what was measured and whether it was met."""
+    out = []
+
+    def ratio(case, ranks, a, b):
+        ra, rb = find(rows, case, ranks, a), find(rows, case, ranks, b)
+        return ra["min_seconds"] / rb["min_seconds"] if ra and rb else None
+
+    def add(text, value, limit, below):
+        if value is None:
+            out.append("| %s | not measured | - |" % text)
+        else:
+            met = value <= limit if below else value >= limit
+            out.append("| %s | %.3f | %s |" % (text, value, "met" if met else "**not met**"))
+
+    add("512^3 phantom, seeded at 1 rank / vtkFlyingEdges3D (at most 0.5)",
+        ratio("phantom512", 1, "seeded", "fe"), 0.5, True)
+    add("512^3 phantom, seeded at 1 rank / Contour + Connectivity (at most 0.1)",
+        ratio("phantom512", 1, "seeded", "contour+connectivity"), 0.1, True)
+    one, two = find(rows, "phantom512", 1, "seeded"), find(rows, "phantom512", 2, "seeded")
+    add("512^3 phantom, seeded speedup at 2 ranks (at least 1.7)",
+        one["min_seconds"] / two["min_seconds"] if one and two else None, 1.7, False)
+    add("sparse sphere (512^3), seeded / vtkFlyingEdges3D at 1 rank (at most 0.05)",
+        ratio("sphere512", 1, "seeded", "fe"), 0.05, True)
+    sweep = sorted((r for r in rows if r.get("case", "").startswith("sphere-sweep-") and r.get("method") == "seeded"),
+                   key=lambda r: r["dims"][0])
+    growth = sweep[-1]["min_seconds"] / sweep[0]["min_seconds"] - 1 if len(sweep) > 1 else None
+    add("growth of the seeded time with empty volume, %s^3 to %s^3 (under 0.10)" % (
+        sweep[0]["dims"][0] if sweep else "?", sweep[-1]["dims"][0] if sweep else "?"), growth, 0.10, True)
+    return out
+
+
+def plots(rows, args, output):
+    """PNG plots; returns their file names (none without matplotlib)."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("no matplotlib: no plots (Debian: apt-get install python3-matplotlib)")
+        return []
+    made = []
+    sweep = [r for r in rows if r.get("case", "").startswith("sphere-sweep-")]
+    if sweep:
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        for method, style in (("seeded", "o-"), ("fe", "s--"), ("contour", "^--")):
+            points = sorted((r["dims"][0], r["min_seconds"]) for r in sweep if r["method"] == method)
+            if points:
+                ax.plot([p[0] for p in points], [p[1] for p in points], style,
+                        label=NAMES[method].replace("*", ""))
+        ax.set_xscale("log", base=2)
+        ax.set_yscale("log")
+        ax.set_xlabel("volume size N (N^3 voxels); the same sphere of 5424 triangles")
+        ax.set_ylabel("seconds (min of %d), 1 rank" % args.sweep_repeats)
+        ax.set_title("Time against volume size at a fixed surface")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(output, "time-vs-volume.png"), dpi=110)
+        plt.close(fig)
+        made.append("time-vs-volume.png")
+    case = "phantom512" if find(rows, "phantom512", 1, "seeded") else (args.cases[0] if args.cases else None)
+    if case and find(rows, case, 1, "seeded"):
+        methods = [m for m in METHODS if any(find(rows, case, r, m) for r in args.ranks)]
+        fig, ax = plt.subplots(figsize=(9, 4.5))
+        width = 0.8 / len(args.ranks)
+        for i, ranks in enumerate(args.ranks):
+            values = [(find(rows, case, ranks, m) or {}).get("min_seconds", 0) for m in methods]
+            ax.bar([x + i * width for x in range(len(methods))], values, width,
+                   label="%d rank%s%s" % (ranks, "s" if ranks > 1 else "",
+                                          " (oversubscribed)" if ranks > (os.cpu_count() or 1) else ""))
+        ax.set_xticks([x + width * (len(args.ranks) - 1) / 2 for x in range(len(methods))])
+        ax.set_xticklabels([NAMES[m].replace("*", "").replace(" (ours)", "\n(ours)").replace(" (the", "\n(the")
+                            for m in methods], fontsize=7)
+        ax.set_ylabel("seconds (min of %d)" % args.repeats)
+        ax.set_title(CASES.get(case, case))
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(output, "methods-%s.png" % case), dpi=110)
+        plt.close(fig)
+        made.append("methods-%s.png" % case)
+    return made
+
+
+def report(rows, args, pictures):
+    cores = os.cpu_count() or 1
+    header = ["%d rank%s%s" % (r, "s" if r > 1 else "", "*" if r > cores else "") for r in args.ranks]
+    lines = ["# RGMC evaluation", "",
+             "Machine: %s. Date: %s. One process set of %d MPI processes; %d repeats (sweep: %d); "
+             "times are the slowest rank's, in seconds, min (median). %s" % (
+                 machine(), datetime.date.today().isoformat(), max(args.ranks), args.repeats,
+                 args.sweep_repeats,
+                 "`*`: more ranks than cores (oversubscribed): those times measure correctness "
+                 "under load, not speed." if max(args.ranks) > cores else ""),
+             "", "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+             "## Targets", "", "| target | measured | |", "|---|---|---|"] + targets(rows, args) + [""]
+    for case in args.cases:
+        if not find(rows, case, 1, "seeded"):
+            continue
+        first = find(rows, case, 1, "seeded")
+        lines += ["## %s" % CASES.get(case, case), "",
+                  "Volume %s. Table 1 of the paper: MC, RGMC (seeded, 1 rank) and its parallel method "
+                  "(seeded, more ranks), with the other ways to the same or a larger surface." % (
+                      " x ".join(map(str, first["dims"]))), "",
+                  "| method | triangles | " + " | ".join(header) + " | peak MiB/rank (1 rank) |",
+                  "|---|---|" + "---|" * len(args.ranks) + "---|"]
+        for method in METHODS:
+            cells = [find(rows, case, r, method) for r in args.ranks]
+            if not any(cells):
+                continue
+            some = next(c for c in cells if c)
+            one = cells[0]
+            lines.append("| %s | %d | %s | %s |" % (
+                NAMES[method], some["triangles"], " | ".join(seconds(c) for c in cells),
+                "%.0f (+%.0f)" % (one["peak_rss_mib"], one["method_rss_mib"]) if one and one["peak_rss_mib"] else "-"))
+        lines.append("")
+        # Table 2 of the paper: time against the number of processes.
+        speedups = []
+        for ranks in args.ranks[1:]:
+            many = find(rows, case, ranks, "seeded")
+            if many:
+                share = many["busiest_rank_triangles"] / max(1, many["triangles"])
+                speedups.append("%d rank%s%s: %.2f (the busiest rank makes %.0f%% of the triangles, "
+                                "which bounds it near %.2f)" % (
+                                    ranks, "s" if ranks > 1 else "", "*" if ranks > cores else "",
+                                    first["min_seconds"] / many["min_seconds"], 100 * share, 1 / share))
+        if speedups:
+            lines += ["Seeded speedup (Table 2 of the paper): " + "; ".join(speedups) + ".", ""]
+        fe, cc = find(rows, case, 1, "fe"), find(rows, case, 1, "contour+connectivity")
+        if fe and cc:
+            lines += ["At 1 rank the seeded mode takes %.3fx the time of vtkFlyingEdges3D and %.3fx that "
+                      "of Contour + Connectivity, whose surface it equals (%d and %d triangles)." % (
+                          first["min_seconds"] / fe["min_seconds"], first["min_seconds"] / cc["min_seconds"],
+                          first["triangles"], cc["triangles"]), ""]
+        distances = [r for r in rows if r.get("case") == case and "distance" in r]
+        if distances:
+            lines += ["Hausdorff distances (symmetric, between vertex sets, as the paper's section 4.3; in "
+                      "voxels):", "", "| | " + " | ".join(header) + " |", "|---|" + "---|" * len(args.ranks)]
+            for what in dict.fromkeys(r["distance"] for r in distances):
+                cells = []
+                for ranks in args.ranks:
+                    d = [r for r in distances if r["ranks"] == ranks and r["distance"] == what]
+                    cells.append("%.3g" % (d[0]["hausdorff"] / d[0]["spacing"]) if d else "-")
+                lines.append("| %s | %s |" % (what, " | ".join(cells)))
+            lines.append("")
+    sweep = sorted((r for r in rows if r.get("case", "").startswith("sphere-sweep-")),
+                   key=lambda r: (r["dims"][0], METHODS.index(r["method"])))
+    if sweep:
+        sizes = sorted(set(r["dims"][0] for r in sweep))
+        lines += ["## Time against volume size at a fixed surface", "",
+                  "The same sphere (radius 12 voxels, 5424 triangles, fixed place) in N^3 voxels of "
+                  "empty space, 1 rank, seconds (min of %d):" % args.sweep_repeats, "",
+                  "| method | " + " | ".join("%d^3" % n for n in sizes) + " |", "|---|" + "---|" * len(sizes)]
+        for method in ("seeded", "fe", "contour"):
+            cells = []
+            for n in sizes:
+                r = [x for x in sweep if x["dims"][0] == n and x["method"] == method]
+                cells.append("%.4f" % r[0]["min_seconds"] if r else "-")
+            lines.append("| %s | %s |" % (NAMES[method], " | ".join(cells)))
+        lines.append("")
+    for picture in pictures:
+        lines += ["![%s](%s)" % (picture, picture), ""]
+    skipped = [r for r in rows if "skipped" in r]
+    for r in skipped:
+        lines += ["Skipped %s: %s." % (r["skipped"], r["why"]), ""]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(prog="rgmc_evaluate.py", description=__doc__.split("\n")[0])
+    parser.add_argument("--cases", default="phantom256,phantom512,sphere512,blobs,mri")
+    parser.add_argument("--ranks", default="1,2,4", help="rank counts; the largest is the process set's size")
+    parser.add_argument("--sweep", default="128,256,512,1024", help="volume sizes of the sphere sweep")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--sweep-repeats", type=int, default=3)
+    parser.add_argument("--mri", default="/usr/share/mricron/templates/ch2.nii.gz")
+    parser.add_argument("--quick", action="store_true", help="every size divided by 4 (a smoke run)")
+    parser.add_argument("--binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcEvaluation"))
+    parser.add_argument("--output", default=os.path.join(rgmc_common.ROOT, "build", "evaluation"),
+                        help="folder for report.md, results.json and the plots")
+    args = parser.parse_args(argv)
+    args.cases = [c for c in args.cases.split(",") if c]
+    args.ranks = sorted(int(r) for r in args.ranks.split(","))
+    args.sweep = [int(n) for n in args.sweep.split(",") if n]
+    if not os.path.isfile(args.binary):
+        raise rgmc_common.UsageError("no evaluation program at %s: build first (./rgmc build)" % args.binary)
+    rows = run(args)
+    os.makedirs(args.output, exist_ok=True)
+    with open(os.path.join(args.output, "results.json"), "w") as out:
+        json.dump(rows, out, indent=1)
+    pictures = plots(rows, args, args.output)
+    text = report(rows, args, pictures)
+    with open(os.path.join(args.output, "report.md"), "w") as out:
+        out.write(text)
+    print("\n" + text)
+    print("written: %s" % os.path.join(args.output, "report.md"))
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main(sys.argv[1:]))
+    except rgmc_common.UsageError as error:
+        print("rgmc_evaluate: error: %s" % error, file=sys.stderr)
+        sys.exit(2)
