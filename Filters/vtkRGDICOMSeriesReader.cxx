@@ -4,6 +4,8 @@
 
 #include "vtkRGPacking.h"
 
+#include "rgmcDicomStructure.h"
+
 #include "vtkDataArray.h"
 #include "vtkMath.h"
 #include "vtkObjectFactory.h"
@@ -19,6 +21,7 @@
 #include <gdcmTag.h>
 #include <gdcmTrace.h>
 #include <gdcmTransferSyntax.h>
+#include <gdcmUIDs.h>
 
 #include <algorithm>
 #include <cmath>
@@ -85,6 +88,8 @@ struct FileHeader
   std::vector<double> FrameOffsets;
   double SpacingBetweenSlices = 0, SliceThickness = 0;
   double Projection = 0; // position along the slice normal
+  bool Encapsulated = false;
+  std::uint64_t PixelBytes = 0; // native pixel data present in the file
 };
 
 std::string Trim(std::string s)
@@ -161,6 +166,17 @@ bool UnsignedShort(const gdcm::DataSet& ds, const gdcm::Tag& tag, int& value)
   return true;
 }
 
+/// "1.2.840.10008.1.2.4.100 (MPEG2 Main Profile @ Main Level)", for messages.
+std::string TransferSyntaxName(const std::string& uid)
+{
+  gdcm::UIDs known;
+  if (known.SetFromUID(uid.c_str()) && known.GetName())
+  {
+    return uid + " (" + known.GetName() + ")";
+  }
+  return uid;
+}
+
 bool DecodableTransferSyntax(int ts)
 {
   switch (ts)
@@ -185,15 +201,6 @@ bool DecodableTransferSyntax(int ts)
   }
 }
 
-bool Encapsulated(int ts)
-{
-  return ts != gdcm::TransferSyntax::ImplicitVRLittleEndian &&
-    ts != gdcm::TransferSyntax::ImplicitVRBigEndianPrivateGE &&
-    ts != gdcm::TransferSyntax::ExplicitVRLittleEndian &&
-    ts != gdcm::TransferSyntax::DeflatedExplicitVRLittleEndian &&
-    ts != gdcm::TransferSyntax::ExplicitVRBigEndian;
-}
-
 /// True when the file starts as a DICOM Part 10 file does (128 bytes, then "DICM").
 bool HasDicomMark(const std::string& path)
 {
@@ -214,6 +221,23 @@ enum class Parsed
 Parsed ParseHeader(const std::string& path, FileHeader& h, std::string& problem)
 {
   h.Path = path;
+  // GDCM aborts on some malformed files: it parses only files whose structure holds.
+  const rgmc::DicomStructure structure = rgmc::WalkDicom(path);
+  if (!structure.Dicom)
+  {
+    return Parsed::NotDicom;
+  }
+  if (!structure.Valid)
+  {
+    problem = "is truncated or corrupt: " + structure.Problem;
+    return Parsed::Broken;
+  }
+  if (!structure.HasPixelData)
+  {
+    return Parsed::NoImage;
+  }
+  h.Encapsulated = structure.PixelDataEncapsulated;
+  h.PixelBytes = structure.PixelDataLength;
   const bool marked = HasDicomMark(path);
   gdcm::Reader reader;
   reader.SetFileName(path.c_str());
@@ -373,10 +397,8 @@ bool CheckPixelFormat(const FileHeader& h, std::string& problem)
   }
   else if (!DecodableTransferSyntax(h.TransferSyntax))
   {
-    why << "has the transfer syntax " << h.TransferSyntaxUID << " ("
-        << gdcm::TransferSyntax::GetTSString(
-             static_cast<gdcm::TransferSyntax::TSType>(h.TransferSyntax))
-        << "), which GDCM does not decode: unsupported transfer syntax";
+    why << "has the transfer syntax " << TransferSyntaxName(h.TransferSyntaxUID)
+        << ", which GDCM does not decode: unsupported transfer syntax";
   }
   problem = why.str();
   return problem.empty();
@@ -430,6 +452,13 @@ vtkRGDICOMSeriesReader::~vtkRGDICOMSeriesReader()
 int vtkRGDICOMSeriesReader::GetNumberOfFiles() const
 {
   return static_cast<int>(this->Internal->Files);
+}
+
+//------------------------------------------------------------------------------
+const char* vtkRGDICOMSeriesReader::GetSliceFileName(int k) const
+{
+  const auto& slices = this->Internal->Slices;
+  return k >= 0 && k < static_cast<int>(slices.size()) ? slices[k].Path.c_str() : nullptr;
 }
 
 //------------------------------------------------------------------------------
@@ -570,8 +599,10 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   }
   if (found == series.end())
   {
-    message = "no series " + chosenUID + " in " + directory + "; it holds: " + list.str();
-    message.pop_back();
+    std::string held = list.str();
+    held.pop_back();
+    std::replace(held.begin(), held.end(), '\n', ';');
+    message = "no series " + chosenUID + " in " + directory + "; it holds: " + held;
     return false;
   }
   std::vector<FileHeader>& files = found->second;
@@ -598,6 +629,15 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
     if (!CheckPixelFormat(h, problem))
     {
       message = h.Path + " " + problem;
+      return false;
+    }
+    const std::uint64_t frame = h.BitsAllocated == 1
+      ? (std::uint64_t(h.Rows) * h.Columns * h.Samples + 7) / 8
+      : std::uint64_t(h.Rows) * h.Columns * h.Samples * (h.BitsAllocated / 8);
+    if (!h.Encapsulated && h.PixelBytes < frame * h.Frames)
+    {
+      message = h.Path + " is truncated: its pixel data has " + std::to_string(h.PixelBytes) +
+        " of the " + std::to_string(frame * h.Frames) + " bytes its header announces";
       return false;
     }
   }
@@ -940,13 +980,21 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
   std::string loaded; // the file in `buffer` (a multi-frame file serves several slices)
   int loadedFrames = 0;
   vtkIdType at = 0;
-  const unsigned shift = static_cast<unsigned>(in.BitsAllocated - in.BitsStored);
+  this->NumberOfFilesRead = 0;
 
   for (int k = extent[4]; k <= extent[5]; ++k)
   {
     const Slice& slice = in.Slices[k];
     if (slice.Path != loaded)
     {
+      // The file may have changed since the scan: GDCM sees it only if its structure holds.
+      const rgmc::DicomStructure structure = rgmc::WalkDicom(slice.Path);
+      if (!structure.Valid || !structure.HasPixelData)
+      {
+        message = slice.Path + " is truncated or corrupt: " +
+          (structure.Problem.empty() ? std::string("no pixel data") : structure.Problem);
+        return false;
+      }
       gdcm::ImageReader reader;
       reader.SetFileName(slice.Path.c_str());
       bool read = false;
@@ -978,13 +1026,9 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
         return false;
       }
       // Native pixel data must hold every frame; GDCM accepts a short one with a warning.
-      const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
-      if (!Encapsulated(in.TransferSyntax))
+      if (!structure.PixelDataEncapsulated)
       {
-        const gdcm::ByteValue* bv = ds.FindDataElement(PixelDataTag)
-          ? ds.GetDataElement(PixelDataTag).GetByteValue()
-          : nullptr;
-        const std::size_t have = bv ? static_cast<std::size_t>(bv->GetLength()) : 0;
+        const std::size_t have = static_cast<std::size_t>(structure.PixelDataLength);
         if (have < frameBytes * loadedFrames)
         {
           message = slice.Path + " is truncated: its pixel data has " + std::to_string(have) +
@@ -1012,12 +1056,13 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
       if (!decoded)
       {
         message = slice.Path + " cannot be decoded by GDCM (transfer syntax " +
-          gdcm::TransferSyntax::GetTSString(
-            static_cast<gdcm::TransferSyntax::TSType>(in.TransferSyntax)) +
+          TransferSyntaxName(gdcm::TransferSyntax::GetTSString(
+            static_cast<gdcm::TransferSyntax::TSType>(in.TransferSyntax))) +
           "): truncated or corrupt compressed data";
         return false;
       }
       loaded = slice.Path;
+      ++this->NumberOfFilesRead;
     }
     const char* frame = buffer.data() + frameBytes * slice.Frame;
     // Planar configuration 1 stores each colour plane after the other.
@@ -1058,7 +1103,6 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
       at += static_cast<vtkIdType>(values.size());
     }
   }
-  (void)shift;
   return true;
 }
 
@@ -1074,4 +1118,5 @@ void vtkRGDICOMSeriesReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "RescaleSlope: " << this->RescaleSlope << "\n";
   os << indent << "RescaleIntercept: " << this->RescaleIntercept << "\n";
   os << indent << "LargestSpacingDeviation: " << this->LargestSpacingDeviation << "\n";
+  os << indent << "NumberOfFilesRead: " << this->NumberOfFilesRead << "\n";
 }

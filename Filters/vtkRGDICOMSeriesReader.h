@@ -68,15 +68,22 @@ public:
   ///@{
   /**
    * After an update: the series found in the directory, one per line ("UID: N files,
-   * description"), the chosen one first; the number of files read; the rescale of the first
-   * slice; the largest deviation of a slice gap from the mean slice spacing (mm).
+   * description"), the chosen one first; the number of files of the series; the file of slice
+   * k (sorted; null when out of range); the rescale of the first slice; the largest deviation
+   * of a slice gap from the mean slice spacing (mm).
    */
   const char* GetSeriesList() const { return this->SeriesList.c_str(); }
   int GetNumberOfFiles() const;
+  const char* GetSliceFileName(int k) const;
   double GetRescaleSlope() const { return this->RescaleSlope; }
   double GetRescaleIntercept() const { return this->RescaleIntercept; }
   double GetLargestSpacingDeviation() const { return this->LargestSpacingDeviation; }
   ///@}
+
+  /**
+   * How many files this rank decoded in its last update: the files of its own slices only.
+   */
+  int GetNumberOfFilesRead() const { return this->NumberOfFilesRead; }
 
 protected:
   vtkRGDICOMSeriesReader();
@@ -91,6 +98,7 @@ protected:
   double RescaleSlope = 1.0;
   double RescaleIntercept = 0.0;
   double LargestSpacingDeviation = 0.0;
+  int NumberOfFilesRead = 0;
 
 private:
   vtkRGDICOMSeriesReader(const vtkRGDICOMSeriesReader&) = delete;

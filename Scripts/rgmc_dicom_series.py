@@ -2,7 +2,7 @@
 
   pvbatch Scripts/rgmc_dicom_series.py --phantom 256 --output ct-phantom-dicom/
   /usr/bin/python3 Scripts/rgmc_dicom_series.py --volume hu.npy --spacing 1,1,1 \\
-      --origin -128,-128,-128 --output series/
+      --origin=-128,-128,-128 --output series/
 
 One file per slice (CT Image Storage), with shuffled file names and InstanceNumbers (a reader
 must sort by ImagePositionPatient), a rescale that reproduces every value exactly (the default,
@@ -142,7 +142,7 @@ def write_series(args, volume, origin, spacing):
         ds.FrameOfReferenceUID = frame
         ds.SeriesDescription = "RGMC CT phantom"
         ds.SeriesNumber = 1
-        ds.InstanceNumber = order[k] + 1
+        ds.InstanceNumber = order[k] + 1 if k < nz else k + 1
         ds.ImagePositionPatient = [number(v) for v in position]
         ds.ImageOrientationPatient = [number(v) for v in list(row) + list(col)]
         ds.PixelSpacing = [number(spacing[1]), number(spacing[0])]  # row spacing, column spacing

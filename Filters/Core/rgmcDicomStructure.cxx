@@ -1,0 +1,441 @@
+// A DICOM structure walk over a file (seeking past values) or, for the deflated transfer syntax,
+// over the inflated data set in memory.
+#include "rgmcDicomStructure.h"
+
+#include <zlib.h>
+
+#include <cstring>
+#include <fstream>
+#include <vector>
+
+namespace rgmc
+{
+namespace
+{
+
+constexpr std::uint32_t Undefined = 0xffffffffu;
+constexpr int MaximumDepth = 32;
+
+/// Bytes from a file or from memory, by absolute position.
+class Source
+{
+public:
+  explicit Source(const std::string& path)
+    : File(path, std::ios::binary)
+  {
+    if (this->File)
+    {
+      this->File.seekg(0, std::ios::end);
+      this->Size = static_cast<std::uint64_t>(this->File.tellg());
+    }
+  }
+  explicit Source(std::vector<unsigned char> memory)
+    : Memory(std::move(memory))
+    , InMemory(true)
+  {
+    this->Size = this->Memory.size();
+  }
+  bool Read(std::uint64_t at, void* out, std::size_t n)
+  {
+    if (at > this->Size || n > this->Size - at)
+    {
+      return false;
+    }
+    if (this->InMemory)
+    {
+      std::memcpy(out, this->Memory.data() + at, n);
+      return true;
+    }
+    this->File.clear();
+    this->File.seekg(static_cast<std::streamoff>(at));
+    return static_cast<bool>(
+      this->File.read(static_cast<char*>(out), static_cast<std::streamsize>(n)));
+  }
+  std::ifstream File;
+  std::vector<unsigned char> Memory;
+  bool InMemory = false;
+  std::uint64_t Size = 0;
+};
+
+struct Syntax
+{
+  bool Explicit = true;
+  bool BigEndian = false;
+};
+
+class Walker
+{
+public:
+  Walker(Source& source, DicomStructure& result)
+    : S(source)
+    , R(result)
+  {
+  }
+
+  std::uint16_t U16(const unsigned char* b, bool big) const
+  {
+    return big ? static_cast<std::uint16_t>((b[0] << 8) | b[1])
+               : static_cast<std::uint16_t>(b[0] | (b[1] << 8));
+  }
+  std::uint32_t U32(const unsigned char* b, bool big) const
+  {
+    return big ? (std::uint32_t(b[0]) << 24) | (std::uint32_t(b[1]) << 16) |
+        (std::uint32_t(b[2]) << 8) | b[3]
+               : (std::uint32_t(b[3]) << 24) | (std::uint32_t(b[2]) << 16) |
+        (std::uint32_t(b[1]) << 8) | b[0];
+  }
+
+  bool Fail(std::uint64_t at, const std::string& what)
+  {
+    if (this->R.Problem.empty())
+    {
+      this->R.Problem = what + " at byte " + std::to_string(at);
+    }
+    return false;
+  }
+
+  struct Element
+  {
+    std::uint16_t Group = 0, Number = 0;
+    char VR[3] = { 0, 0, 0 };
+    std::uint32_t Length = 0;
+    std::uint64_t Value = 0; // position of the value
+  };
+
+  /// Reads an element header at `at`; items and delimiters have no VR in any syntax.
+  bool Header(std::uint64_t at, std::uint64_t end, const Syntax& sx, Element& e)
+  {
+    unsigned char b[12];
+    if (at + 8 > end || !this->S.Read(at, b, 8))
+    {
+      return this->Fail(at, "an element header runs past the end of the file or its item");
+    }
+    e.Group = this->U16(b, sx.BigEndian);
+    e.Number = this->U16(b + 2, sx.BigEndian);
+    if (e.Group == 0xfffe || !sx.Explicit)
+    {
+      e.VR[0] = e.VR[1] = 0;
+      e.Length = this->U32(b + 4, sx.BigEndian);
+      e.Value = at + 8;
+      return true;
+    }
+    e.VR[0] = static_cast<char>(b[4]);
+    e.VR[1] = static_cast<char>(b[5]);
+    if (e.VR[0] < 'A' || e.VR[0] > 'Z' || e.VR[1] < 'A' || e.VR[1] > 'Z')
+    {
+      return this->Fail(at, "an element has no valid value representation");
+    }
+    static const char* const longForms[] = { "OB", "OD", "OF", "OL", "OV", "OW", "SQ", "UC", "UN",
+      "UR", "UT", "SV", "UV" };
+    bool longForm = false;
+    for (const char* vr : longForms)
+    {
+      longForm = longForm || (vr[0] == e.VR[0] && vr[1] == e.VR[1]);
+    }
+    if (longForm)
+    {
+      if (at + 12 > end || !this->S.Read(at + 8, b + 8, 4))
+      {
+        return this->Fail(at, "an element header runs past the end of the file or its item");
+      }
+      e.Length = this->U32(b + 8, sx.BigEndian);
+      e.Value = at + 12;
+    }
+    else
+    {
+      e.Length = this->U16(b + 6, sx.BigEndian);
+      e.Value = at + 8;
+    }
+    return true;
+  }
+
+  /// Items of a sequence (or fragments of encapsulated pixel data) from `at` until the sequence
+  /// delimiter (undefined length) or `end`; `after` gets the position after the sequence.
+  bool Items(std::uint64_t at, std::uint64_t end, bool undefined, const Syntax& sx, int depth,
+    bool fragments, std::uint64_t& after)
+  {
+    while (undefined || at < end)
+    {
+      Element e;
+      if (!this->Header(at, end, Syntax{ false, sx.BigEndian }, e))
+      {
+        return false;
+      }
+      if (e.Group == 0xfffe && e.Number == 0xe0dd)
+      {
+        after = e.Value;
+        return undefined || this->Fail(at, "a sequence delimiter in a sequence of known length");
+      }
+      if (e.Group != 0xfffe || e.Number != 0xe000)
+      {
+        return this->Fail(at, "a sequence holds something other than items");
+      }
+      if (e.Length == Undefined)
+      {
+        if (fragments)
+        {
+          return this->Fail(at, "a pixel data fragment of undefined length");
+        }
+        std::uint64_t next = 0;
+        if (!this->DataSet(e.Value, end, true, sx, depth + 1, next))
+        {
+          return false;
+        }
+        at = next;
+      }
+      else
+      {
+        if (e.Value + e.Length > end)
+        {
+          return this->Fail(at,
+            "an item of " + std::to_string(e.Length) +
+              " bytes runs past the end of the file or its sequence");
+        }
+        if (!fragments)
+        {
+          std::uint64_t next = 0;
+          if (!this->DataSet(e.Value, e.Value + e.Length, false, sx, depth + 1, next))
+          {
+            return false;
+          }
+        }
+        at = e.Value + e.Length;
+      }
+    }
+    after = at;
+    return true;
+  }
+
+  /// Elements from `at` to `end` (or, in an item of undefined length, to its delimiter).
+  bool DataSet(std::uint64_t at, std::uint64_t end, bool untilDelimiter, const Syntax& sx,
+    int depth, std::uint64_t& after)
+  {
+    if (depth > MaximumDepth)
+    {
+      return this->Fail(at, "sequences nested more than " + std::to_string(MaximumDepth) + " deep");
+    }
+    while (untilDelimiter || at < end)
+    {
+      Element e;
+      if (!this->Header(at, end, sx, e))
+      {
+        return false;
+      }
+      if (e.Group == 0xfffe)
+      {
+        if (e.Number == 0xe00d && untilDelimiter)
+        {
+          after = e.Value;
+          return true;
+        }
+        return this->Fail(at, "an item or delimiter out of place");
+      }
+      const bool pixelData = e.Group == 0x7fe0 && e.Number == 0x0010; // an icon's, too
+      const bool topPixelData = pixelData && depth == 0;
+      const bool sequence = (e.VR[0] == 'S' && e.VR[1] == 'Q') ||
+        (e.Length == Undefined && (e.VR[0] == 0 || (e.VR[0] == 'U' && e.VR[1] == 'N')));
+      if (e.Length == Undefined)
+      {
+        if (!sequence && !pixelData)
+        {
+          return this->Fail(at, "an element of undefined length that is not a sequence");
+        }
+        // The content of an undefined-length UN is implicit VR little endian (Part 5, 6.2.2).
+        const Syntax inner = e.VR[0] == 'U' ? Syntax{ false, false } : sx;
+        std::uint64_t next = 0;
+        if (!this->Items(e.Value, end, true, inner, depth, pixelData, next))
+        {
+          return false;
+        }
+        if (topPixelData)
+        {
+          this->R.HasPixelData = true;
+          this->R.PixelDataEncapsulated = true;
+        }
+        at = next;
+        continue;
+      }
+      if (topPixelData)
+      {
+        this->R.HasPixelData = true;
+        this->R.PixelDataDeclared = e.Length;
+        this->R.PixelDataLength =
+          e.Value >= this->S.Size ? 0 : std::min<std::uint64_t>(e.Length, this->S.Size - e.Value);
+        if (e.Value + e.Length > end)
+        {
+          // A short native pixel data: reported as truncated by the reader, with both lengths.
+          after = end;
+          return true;
+        }
+      }
+      else if (e.Value + e.Length > end)
+      {
+        return this->Fail(at,
+          "element (" + Hex(e.Group) + "," + Hex(e.Number) + ") announces " +
+            std::to_string(e.Length) + " bytes, more than the file or its item has left");
+      }
+      if (e.VR[0] == 'S' && e.VR[1] == 'Q' && e.Length > 0)
+      {
+        std::uint64_t next = 0;
+        if (!this->Items(e.Value, e.Value + e.Length, false, sx, depth, false, next))
+        {
+          return false;
+        }
+      }
+      if (depth == 0 && e.Group == 0x0002 && e.Number == 0x0010 && e.Length < 256)
+      {
+        std::string uid(e.Length, '\0');
+        this->S.Read(e.Value, &uid[0], e.Length);
+        while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' '))
+        {
+          uid.pop_back();
+        }
+        this->R.TransferSyntax = uid;
+      }
+      at = e.Value + e.Length;
+    }
+    after = at;
+    return true;
+  }
+
+  static std::string Hex(std::uint16_t v)
+  {
+    static const char digits[] = "0123456789ABCDEF";
+    std::string s(4, '0');
+    for (int n = 3; n >= 0; --n, v >>= 4)
+    {
+      s[n] = digits[v & 15];
+    }
+    return s;
+  }
+
+  Source& S;
+  DicomStructure& R;
+};
+
+/// Inflates raw deflate data from `at` to the end of the file (the deflated transfer syntax).
+bool Inflate(Source& s, std::uint64_t at, std::vector<unsigned char>& out)
+{
+  std::vector<unsigned char> in(static_cast<std::size_t>(s.Size - at));
+  if (!s.Read(at, in.data(), in.size()))
+  {
+    return false;
+  }
+  z_stream z;
+  std::memset(&z, 0, sizeof(z));
+  if (inflateInit2(&z, -15) != Z_OK)
+  {
+    return false;
+  }
+  z.next_in = in.data();
+  z.avail_in = static_cast<uInt>(in.size());
+  unsigned char chunk[1 << 15];
+  int status = Z_OK;
+  while (status == Z_OK)
+  {
+    z.next_out = chunk;
+    z.avail_out = sizeof(chunk);
+    status = inflate(&z, Z_NO_FLUSH);
+    out.insert(out.end(), chunk, chunk + (sizeof(chunk) - z.avail_out));
+    if (out.size() > (std::uint64_t(1) << 32))
+    {
+      status = Z_DATA_ERROR;
+    }
+  }
+  inflateEnd(&z);
+  return status == Z_STREAM_END;
+}
+
+} // namespace
+
+DicomStructure WalkDicom(const std::string& path)
+{
+  DicomStructure result;
+  Source source(path);
+  if (!source.File)
+  {
+    result.Problem = "cannot be opened";
+    return result;
+  }
+  unsigned char head[132];
+  std::uint64_t at = 0;
+  Walker walker(source, result);
+  if (source.Read(0, head, 132) && std::memcmp(head + 128, "DICM", 4) == 0)
+  {
+    result.Dicom = true;
+    at = 132;
+    // The file meta information: explicit VR little endian, group 0002 only.
+    while (true)
+    {
+      unsigned char tag[2];
+      if (!source.Read(at, tag, 2) || (tag[0] | (tag[1] << 8)) != 0x0002)
+      {
+        break;
+      }
+      Walker::Element e;
+      if (!walker.Header(at, source.Size, Syntax{ true, false }, e) || e.Length == Undefined ||
+        e.Value + e.Length > source.Size)
+      {
+        if (result.Problem.empty())
+        {
+          result.Problem =
+            "its file meta information is truncated or corrupt at byte " + std::to_string(at);
+        }
+        return result;
+      }
+      if (e.Number == 0x0010 && e.Length < 256)
+      {
+        std::string uid(e.Length, '\0');
+        source.Read(e.Value, &uid[0], e.Length);
+        while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' '))
+        {
+          uid.pop_back();
+        }
+        result.TransferSyntax = uid;
+      }
+      at = e.Value + e.Length;
+    }
+  }
+  else
+  {
+    // A bare data set: it starts with a small group (0008 usually), in either VR form.
+    unsigned char b[8];
+    if (!source.Read(0, b, 8) || b[1] != 0 || b[0] == 0 || b[0] > 0x28 || b[3] != 0)
+    {
+      return result; // not DICOM
+    }
+    result.Dicom = true;
+    const bool explicitVR = b[4] >= 'A' && b[4] <= 'Z' && b[5] >= 'A' && b[5] <= 'Z';
+    std::uint64_t after = 0;
+    result.Valid = walker.DataSet(0, source.Size, false, Syntax{ explicitVR, false }, 0, after);
+    return result;
+  }
+  const std::string& ts = result.TransferSyntax;
+  Syntax sx;
+  sx.Explicit = ts != "1.2.840.10008.1.2" && ts != "1.2.840.113619.5.2" && !ts.empty();
+  sx.BigEndian = ts == "1.2.840.10008.1.2.2" || ts == "1.2.840.113619.5.2";
+  std::uint64_t after = 0;
+  if (ts == "1.2.840.10008.1.2.1.99")
+  {
+    std::vector<unsigned char> inflated;
+    if (!Inflate(source, at, inflated))
+    {
+      result.Problem = "its deflated data set does not inflate (truncated or corrupt)";
+      return result;
+    }
+    Source memory(std::move(inflated));
+    DicomStructure inner;
+    Walker innerWalker(memory, inner);
+    result.Valid = innerWalker.DataSet(0, memory.Size, false, sx, 0, after);
+    result.Problem = inner.Problem;
+    result.HasPixelData = inner.HasPixelData;
+    result.PixelDataEncapsulated = inner.PixelDataEncapsulated;
+    result.PixelDataLength = inner.PixelDataLength;
+    result.PixelDataDeclared = inner.PixelDataDeclared;
+    return result;
+  }
+  result.Valid = walker.DataSet(at, source.Size, false, sx, 0, after);
+  return result;
+}
+
+} // namespace rgmc
