@@ -62,16 +62,14 @@ public:
    * The pieces of all ranks appended, with the points that share a global id merged: what
    * this writer writes (exposed for tests).
    */
-  static vtkSmartPointer<vtkPolyData> Merge(
-    const std::vector<vtkSmartPointer<vtkDataObject>>& pieces);
+  static vtkSmartPointer<vtkPolyData> Merge(const std::vector<vtkSmartPointer<vtkDataObject>>& pieces);
 
 protected:
   vtkRGMergedSurfaceWriter();
   ~vtkRGMergedSurfaceWriter() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
-  vtkTypeBool ProcessRequest(
-    vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   void WriteData() override;
 
   char* FileName = nullptr;
