@@ -15,7 +15,8 @@
 #include <gdcmDataSet.h>
 #include <gdcmFile.h>
 #include <gdcmImage.h>
-#include <gdcmImageReader.h>
+#include <gdcmPhotometricInterpretation.h>
+#include <gdcmPixelFormat.h>
 #include <gdcmReader.h>
 #include <gdcmSequenceOfFragments.h>
 #include <gdcmTag.h>
@@ -53,6 +54,7 @@ const gdcm::Tag RowsTag(0x0028, 0x0010);
 const gdcm::Tag ColumnsTag(0x0028, 0x0011);
 const gdcm::Tag SamplesTag(0x0028, 0x0002);
 const gdcm::Tag PlanarTag(0x0028, 0x0006);
+const gdcm::Tag PhotometricTag(0x0028, 0x0004);
 const gdcm::Tag BitsAllocatedTag(0x0028, 0x0100);
 const gdcm::Tag BitsStoredTag(0x0028, 0x0101);
 const gdcm::Tag PixelRepresentationTag(0x0028, 0x0103);
@@ -77,7 +79,7 @@ struct QuietGDCM
 /// What the scan keeps of one file.
 struct FileHeader
 {
-  std::string Path, SeriesUID, SeriesDescription, Modality, TransferSyntaxUID;
+  std::string Path, SeriesUID, SeriesDescription, Modality, TransferSyntaxUID, Photometric;
   int TransferSyntax = gdcm::TransferSyntax::TS_END;
   int Rows = 0, Columns = 0, Samples = 1, Planar = 0, BitsAllocated = 0, BitsStored = 0;
   int PixelRepresentation = 0, Frames = 1;
@@ -278,6 +280,7 @@ Parsed ParseHeader(const std::string& path, FileHeader& h, std::string& problem)
   h.Modality = Text(ds, ModalityTag);
   UnsignedShort(ds, SamplesTag, h.Samples);
   UnsignedShort(ds, PlanarTag, h.Planar);
+  h.Photometric = Text(ds, PhotometricTag);
   UnsignedShort(ds, BitsAllocatedTag, h.BitsAllocated);
   if (!UnsignedShort(ds, BitsStoredTag, h.BitsStored))
   {
@@ -404,6 +407,23 @@ bool CheckPixelFormat(const FileHeader& h, std::string& problem)
   return problem.empty();
 }
 
+/// Bytes of one native frame. Uncompressed YBR_FULL_422 stores two luminance samples and one
+/// pair of chroma samples per two pixels.
+std::uint64_t NativeFrameBytes(
+  int rows, int columns, int samples, int bitsAllocated, const std::string& photometric)
+{
+  const std::uint64_t pixels = std::uint64_t(rows) * columns;
+  if (bitsAllocated == 1)
+  {
+    return (pixels * samples + 7) / 8;
+  }
+  if (samples == 3 && photometric == "YBR_FULL_422")
+  {
+    return pixels * 2 * (bitsAllocated / 8);
+  }
+  return pixels * samples * (bitsAllocated / 8);
+}
+
 std::string BaseName(const std::string& path)
 {
   return fs::path(path).filename().string();
@@ -432,7 +452,9 @@ struct vtkRGDICOMSeriesReader::Internals
   // From the header, the same on every rank.
   std::vector<Slice> Slices;
   int Rows = 0, Columns = 0, Samples = 1, Planar = 0, BitsAllocated = 0, BitsStored = 0;
-  int PixelRepresentation = 0, TransferSyntax = 0;
+  int PixelRepresentation = 0, TransferSyntax = 0, Frames = 1;
+  bool Encapsulated = false;
+  std::string Photometric;
   std::size_t Files = 0;
 };
 
@@ -547,7 +569,7 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   }
   if (!isDirectory && chosenUID.empty())
   {
-    message = name + " is not a DICOM file with an image";
+    message = name + " holds no DICOM image (no pixel data, or not DICOM)";
     return false;
   }
   if (images.empty())
@@ -631,9 +653,8 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
       message = h.Path + " " + problem;
       return false;
     }
-    const std::uint64_t frame = h.BitsAllocated == 1
-      ? (std::uint64_t(h.Rows) * h.Columns * h.Samples + 7) / 8
-      : std::uint64_t(h.Rows) * h.Columns * h.Samples * (h.BitsAllocated / 8);
+    const std::uint64_t frame =
+      NativeFrameBytes(h.Rows, h.Columns, h.Samples, h.BitsAllocated, h.Photometric);
     if (!h.Encapsulated && h.PixelBytes < frame * h.Frames)
     {
       message = h.Path + " is truncated: its pixel data has " + std::to_string(h.PixelBytes) +
@@ -899,7 +920,8 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   p.Number(first.BitsStored).Number(first.PixelRepresentation).Number(first.TransferSyntax);
   p.Number(deviation).Number(static_cast<double>(files.size()));
   p.String(isCT ? "HU" : "Intensity").String(list.str()).String(warnings.str());
-  p.String(summary.str());
+  p.String(summary.str()).String(first.Photometric);
+  p.Number(first.Encapsulated ? 1 : 0).Number(first.Frames);
   for (const Slice& s : slices)
   {
     p.String(s.Path).Number(s.Frame).Number(s.Slope).Number(s.Intercept);
@@ -942,6 +964,9 @@ bool vtkRGDICOMSeriesReader::Parse(const std::string& header, std::string& messa
   this->SeriesList = u.String();
   this->Warnings = u.String();
   this->Summary = u.String();
+  in.Photometric = u.String();
+  in.Encapsulated = u.Int() != 0;
+  in.Frames = u.Int();
   in.Columns = this->Dimensions[0];
   in.Rows = this->Dimensions[1];
   this->NumberOfComponents = in.Samples;
@@ -972,13 +997,17 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
   const int samples = in.Samples;
   const std::size_t bytes = in.BitsAllocated == 1 ? 0 : in.BitsAllocated / 8;
   const std::size_t pixelsPerFrame = static_cast<std::size_t>(in.Rows) * in.Columns;
-  const std::size_t frameBytes =
-    in.BitsAllocated == 1 ? (pixelsPerFrame * samples + 7) / 8 : pixelsPerFrame * samples * bytes;
+  const bool encapsulated = in.Encapsulated;
+  // Decoders give full frames; native YBR_FULL_422 stays subsampled (expanded below).
+  const bool subsampled = !encapsulated && samples == 3 && in.Photometric == "YBR_FULL_422";
+  const std::size_t frameBytes = encapsulated
+    ? NativeFrameBytes(in.Rows, in.Columns, samples, in.BitsAllocated, std::string())
+    : NativeFrameBytes(in.Rows, in.Columns, samples, in.BitsAllocated, in.Photometric);
   const int width = extent[1] - extent[0] + 1;
   std::vector<double> values(static_cast<std::size_t>(width) * samples);
   std::vector<char> buffer;
   std::string loaded; // the file in `buffer` (a multi-frame file serves several slices)
-  int loadedFrames = 0;
+  int decodedPlanar = in.Planar;
   vtkIdType at = 0;
   this->NumberOfFilesRead = 0;
 
@@ -989,76 +1018,112 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
     {
       // The file may have changed since the scan: GDCM sees it only if its structure holds.
       const rgmc::DicomStructure structure = rgmc::WalkDicom(slice.Path);
-      if (!structure.Valid || !structure.HasPixelData)
+      if (!structure.Valid || !structure.HasPixelData ||
+        structure.PixelDataEncapsulated != encapsulated)
       {
         message = slice.Path + " is truncated or corrupt: " +
-          (structure.Problem.empty() ? std::string("no pixel data") : structure.Problem);
+          (structure.Problem.empty() ? std::string("its pixel data changed since the header scan")
+                                     : structure.Problem);
         return false;
       }
-      gdcm::ImageReader reader;
-      reader.SetFileName(slice.Path.c_str());
-      bool read = false;
-      try
+      const std::size_t expected = frameBytes * in.Frames;
+      if (!encapsulated && structure.PixelDataLength < expected)
       {
-        read = reader.Read();
-      }
-      catch (...)
-      {
-        read = false;
-      }
-      if (!read)
-      {
-        message = slice.Path + " cannot be read by GDCM (truncated or corrupt)";
+        message = slice.Path + " is truncated: its pixel data has " +
+          std::to_string(structure.PixelDataLength) + " bytes of the " + std::to_string(expected) +
+          " its header announces";
         return false;
       }
-      const gdcm::Image& image = reader.GetImage();
-      const gdcm::PixelFormat& pf = image.GetPixelFormat();
-      loadedFrames =
-        image.GetNumberOfDimensions() > 2 ? static_cast<int>(image.GetDimension(2)) : 1;
-      if (static_cast<int>(image.GetDimension(0)) != in.Columns ||
-        static_cast<int>(image.GetDimension(1)) != in.Rows ||
-        static_cast<int>(pf.GetSamplesPerPixel()) != samples ||
-        static_cast<int>(pf.GetBitsAllocated()) != in.BitsAllocated || loadedFrames <= slice.Frame)
+      bool decoded = false;
+      if (!encapsulated && structure.PixelDataOffset > 0)
       {
-        message = slice.Path + " changed since the header scan (its image is now " +
-          std::to_string(image.GetDimension(0)) + " x " + std::to_string(image.GetDimension(1)) +
-          ")";
-        return false;
-      }
-      // Native pixel data must hold every frame; GDCM accepts a short one with a warning.
-      if (!structure.PixelDataEncapsulated)
-      {
-        const std::size_t have = static_cast<std::size_t>(structure.PixelDataLength);
-        if (have < frameBytes * loadedFrames)
+        // Native pixel data: read straight from the file, swapped to this host's byte order.
+        std::ifstream file(slice.Path, std::ios::binary);
+        buffer.assign(expected, 0);
+        file.seekg(static_cast<std::streamoff>(structure.PixelDataOffset));
+        decoded =
+          static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(expected)));
+        const int word = in.BitsAllocated == 1 ? 1 : in.BitsAllocated / 8; // bits stay in bytes
+        if (structure.BigEndian && word > 1)
         {
-          message = slice.Path + " is truncated: its pixel data has " + std::to_string(have) +
-            " bytes of the " + std::to_string(frameBytes * loadedFrames) + " its header announces";
+          for (std::size_t b = 0; b + word <= buffer.size(); b += word)
+          {
+            std::reverse(buffer.begin() + b, buffer.begin() + b + word);
+          }
+        }
+        decodedPlanar = in.Planar;
+      }
+      else if (in.TransferSyntax == gdcm::TransferSyntax::RLELossless && in.BitsAllocated >= 8)
+      {
+        // RLE ourselves: GDCM 3.0.21 orders the bytes of 16- and 32-bit colour RLE wrongly.
+        decoded = structure.Fragments.size() == static_cast<std::size_t>(in.Frames);
+        std::string problem = "it has " + std::to_string(structure.Fragments.size()) +
+          " RLE fragments for " + std::to_string(in.Frames) + " frames";
+        buffer.assign(expected, 0);
+        for (int f = 0; decoded && f < in.Frames; ++f)
+        {
+          decoded = rgmc::DecodeRleFrame(slice.Path, structure.Fragments[f].first,
+            structure.Fragments[f].second, pixelsPerFrame, samples, in.BitsAllocated / 8,
+            buffer.data() + frameBytes * f, problem);
+        }
+        if (!decoded)
+        {
+          message = slice.Path + " has malformed RLE pixel data: " + problem;
           return false;
         }
+        decodedPlanar = 0;
       }
-      const std::size_t length = image.GetBufferLength();
-      if (length < frameBytes * loadedFrames)
+      else
       {
-        message = slice.Path + " decodes to " + std::to_string(length) + " bytes, not " +
-          std::to_string(frameBytes * loadedFrames);
-        return false;
-      }
-      buffer.assign(length, 0);
-      bool decoded = false;
-      try
-      {
-        decoded = image.GetBuffer(buffer.data());
-      }
-      catch (...)
-      {
-        decoded = false;
+        // GDCM's parser and codecs, given the pixel description of the header scan (its
+        // ImageReader also guesses geometry, and asserts on some valid files while doing so).
+        gdcm::Reader reader;
+        reader.SetFileName(slice.Path.c_str());
+        try
+        {
+          if (reader.Read() && reader.GetFile().GetDataSet().FindDataElement(PixelDataTag))
+          {
+            gdcm::Image image;
+            image.SetNumberOfDimensions(in.Frames > 1 ? 3 : 2);
+            image.SetDimension(0, static_cast<unsigned>(in.Columns));
+            image.SetDimension(1, static_cast<unsigned>(in.Rows));
+            if (in.Frames > 1)
+            {
+              image.SetDimension(2, static_cast<unsigned>(in.Frames));
+            }
+            image.SetPixelFormat(gdcm::PixelFormat(static_cast<unsigned short>(samples),
+              static_cast<unsigned short>(in.BitsAllocated),
+              static_cast<unsigned short>(in.BitsStored),
+              static_cast<unsigned short>(in.BitsStored - 1),
+              static_cast<unsigned short>(in.PixelRepresentation)));
+            const gdcm::PhotometricInterpretation::PIType pi =
+              gdcm::PhotometricInterpretation::GetPIType(in.Photometric.c_str());
+            image.SetPhotometricInterpretation(pi == gdcm::PhotometricInterpretation::PI_END
+                ? gdcm::PhotometricInterpretation(gdcm::PhotometricInterpretation::MONOCHROME2)
+                : gdcm::PhotometricInterpretation(pi));
+            if (samples == 3)
+            {
+              image.SetPlanarConfiguration(static_cast<unsigned>(in.Planar));
+            }
+            image.SetTransferSyntax(reader.GetFile().GetHeader().GetDataSetTransferSyntax());
+            image.SetDataElement(reader.GetFile().GetDataSet().GetDataElement(PixelDataTag));
+            buffer.assign(std::max<std::size_t>(image.GetBufferLength(), expected), 0);
+            decoded = image.GetBuffer(buffer.data());
+            // A codec may hand back interleaved samples whatever the header said.
+            decodedPlanar = samples == 3 ? static_cast<int>(image.GetPlanarConfiguration()) : 0;
+          }
+        }
+        catch (...)
+        {
+          decoded = false;
+        }
       }
       if (!decoded)
       {
         message = slice.Path + " cannot be decoded by GDCM (transfer syntax " +
           TransferSyntaxName(gdcm::TransferSyntax::GetTSString(
             static_cast<gdcm::TransferSyntax::TSType>(in.TransferSyntax))) +
-          "): truncated or corrupt compressed data";
+          "): truncated or corrupt pixel data";
         return false;
       }
       loaded = slice.Path;
@@ -1066,7 +1131,7 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
     }
     const char* frame = buffer.data() + frameBytes * slice.Frame;
     // Planar configuration 1 stores each colour plane after the other.
-    const bool planar = samples == 3 && in.Planar == 1;
+    const bool planar = samples == 3 && decodedPlanar == 1;
     for (int j = extent[2]; j <= extent[3]; ++j)
     {
       std::size_t n = 0;
@@ -1075,7 +1140,13 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
         for (int c = 0; c < samples; ++c)
         {
           const std::size_t pixel = static_cast<std::size_t>(j) * in.Columns + i;
-          const std::size_t index = planar ? c * pixelsPerFrame + pixel : pixel * samples + c;
+          std::size_t index = planar ? c * pixelsPerFrame + pixel : pixel * samples + c;
+          if (subsampled)
+          {
+            // Y0 Y1 Cb Cr for each pair of pixels of a row.
+            const std::size_t pair = (static_cast<std::size_t>(j) * in.Columns + (i & ~1)) * 2;
+            index = c == 0 ? pair + (i & 1) : pair + 1 + c;
+          }
           double v;
           if (in.BitsAllocated == 1)
           {

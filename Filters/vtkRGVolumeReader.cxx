@@ -20,6 +20,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -70,31 +71,12 @@ int vtkRGVolumeReader::ChooseScalarType(bool integral, double lo, double hi, boo
 void vtkRGVolumeReader::Store(
   vtkDataArray* scalars, vtkIdType at, const double* values, std::size_t count)
 {
+  // Every value is exact in the output type (ChooseScalarType), so a plain conversion is exact.
   switch (scalars->GetDataType())
   {
-    case VTK_SHORT:
-    {
-      short* out = static_cast<vtkShortArray*>(scalars)->GetPointer(0) + at;
-      for (std::size_t n = 0; n < count; ++n)
-      {
-        out[n] = static_cast<short>(values[n]);
-      }
-      break;
-    }
-    case VTK_FLOAT:
-    {
-      float* out = static_cast<vtkFloatArray*>(scalars)->GetPointer(0) + at;
-      for (std::size_t n = 0; n < count; ++n)
-      {
-        out[n] = static_cast<float>(values[n]);
-      }
-      break;
-    }
-    default:
-    {
-      double* out = static_cast<vtkDoubleArray*>(scalars)->GetPointer(0) + at;
-      std::copy(values, values + count, out);
-    }
+    vtkTemplateMacro(
+      std::transform(values, values + count, static_cast<VTK_TT*>(scalars->GetVoidPointer(0)) + at,
+        [](double v) { return static_cast<VTK_TT>(v); }));
   }
 }
 

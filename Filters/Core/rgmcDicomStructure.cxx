@@ -199,6 +199,18 @@ public:
             return false;
           }
         }
+        else if (depth == 0)
+        {
+          // The first item is the basic offset table; the others are the fragments.
+          if (this->FirstItem)
+          {
+            this->FirstItem = false;
+          }
+          else if (!this->S.InMemory)
+          {
+            this->R.Fragments.emplace_back(e.Value, e.Length);
+          }
+        }
         at = e.Value + e.Length;
       }
     }
@@ -259,6 +271,7 @@ public:
       {
         this->R.HasPixelData = true;
         this->R.PixelDataDeclared = e.Length;
+        this->R.PixelDataOffset = this->S.InMemory ? 0 : e.Value;
         this->R.PixelDataLength =
           e.Value >= this->S.Size ? 0 : std::min<std::uint64_t>(e.Length, this->S.Size - e.Value);
         if (e.Value + e.Length > end)
@@ -311,6 +324,7 @@ public:
 
   Source& S;
   DicomStructure& R;
+  bool FirstItem = true;
 };
 
 /// Inflates raw deflate data from `at` to the end of the file (the deflated transfer syntax).
@@ -347,6 +361,79 @@ bool Inflate(Source& s, std::uint64_t at, std::vector<unsigned char>& out)
 }
 
 } // namespace
+
+bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t length,
+  std::size_t pixels, int samples, int bytes, char* out, std::string& problem)
+{
+  Source source(path);
+  std::vector<unsigned char> data(static_cast<std::size_t>(length));
+  if (length < 64 || !source.Read(offset, data.data(), data.size()))
+  {
+    problem = "an RLE frame shorter than its 64-byte header";
+    return false;
+  }
+  auto u32 = [&](std::size_t at)
+  {
+    return std::uint32_t(data[at]) | (std::uint32_t(data[at + 1]) << 8) |
+      (std::uint32_t(data[at + 2]) << 16) | (std::uint32_t(data[at + 3]) << 24);
+  };
+  const std::uint32_t segments = u32(0);
+  if (segments != static_cast<std::uint32_t>(samples * bytes))
+  {
+    problem = "an RLE frame of " + std::to_string(segments) + " segments, not " +
+      std::to_string(samples * bytes);
+    return false;
+  }
+  // Segment s holds, for every pixel, byte (bytes - 1 - s % bytes) (most significant first) of
+  // sample s / bytes.
+  for (std::uint32_t s = 0; s < segments; ++s)
+  {
+    const std::uint64_t begin = u32(4 + 4 * s);
+    const std::uint64_t end = s + 1 < segments ? u32(8 + 4 * s) : length;
+    if (begin < 64 || begin > end || end > length)
+    {
+      problem = "an RLE segment offset outside its frame";
+      return false;
+    }
+    const int sample = static_cast<int>(s) / bytes;
+    const int byte = bytes - 1 - static_cast<int>(s) % bytes; // little endian host
+    std::size_t pixel = 0;
+    auto put = [&](unsigned char v)
+    {
+      if (pixel < pixels)
+      {
+        out[(pixel * samples + sample) * bytes + byte] = static_cast<char>(v);
+      }
+      ++pixel;
+    };
+    for (std::uint64_t at = begin; at < end && pixel < pixels;)
+    {
+      const int n = static_cast<signed char>(data[at++]);
+      if (n >= 0)
+      {
+        for (int c = 0; c <= n && at < end; ++c)
+        {
+          put(data[at++]);
+        }
+      }
+      else if (n != -128 && at < end)
+      {
+        const unsigned char v = data[at++];
+        for (int c = 0; c < 1 - n; ++c)
+        {
+          put(v);
+        }
+      }
+    }
+    if (pixel < pixels)
+    {
+      problem = "an RLE segment that decodes to " + std::to_string(pixel) + " of " +
+        std::to_string(pixels) + " pixels";
+      return false;
+    }
+  }
+  return true;
+}
 
 DicomStructure WalkDicom(const std::string& path)
 {
@@ -414,6 +501,16 @@ DicomStructure WalkDicom(const std::string& path)
   Syntax sx;
   sx.Explicit = ts != "1.2.840.10008.1.2" && ts != "1.2.840.113619.5.2" && !ts.empty();
   sx.BigEndian = ts == "1.2.840.10008.1.2.2" || ts == "1.2.840.113619.5.2";
+  result.BigEndian = sx.BigEndian;
+  // Some files declare explicit VR and hold implicit VR (or the reverse): as pydicom and GDCM
+  // do, the first data set element decides.
+  {
+    unsigned char b[6];
+    if (ts != "1.2.840.10008.1.2.1.99" && source.Read(at, b, 6))
+    {
+      sx.Explicit = b[4] >= 'A' && b[4] <= 'Z' && b[5] >= 'A' && b[5] <= 'Z';
+    }
+  }
   std::uint64_t after = 0;
   if (ts == "1.2.840.10008.1.2.1.99")
   {

@@ -10,6 +10,8 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace rgmc
 {
@@ -24,10 +26,21 @@ struct DicomStructure
   bool PixelDataEncapsulated = false;
   std::uint64_t PixelDataLength = 0;   // bytes of native pixel data present in the file
   std::uint64_t PixelDataDeclared = 0; // bytes its header announces
+  std::uint64_t PixelDataOffset = 0;   // where native pixel data starts in the file (0: not
+                                       // directly readable, as in a deflated data set)
+  bool BigEndian = false;              // the data set's byte order
+  /// Encapsulated pixel data: (offset, length) of each fragment after the offset table.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> Fragments;
 };
 
 /// Walks the file at `path`.
 DicomStructure WalkDicom(const std::string& path);
+
+/// Decodes one RLE Lossless frame (DICOM Part 5 Annex G), the fragment at `offset` of `length`
+/// bytes in `path`, into `out` (pixels * samples samples of `bytes` bytes each, interleaved, this
+/// host's byte order). False with `problem` when the frame is malformed.
+bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t length,
+  std::size_t pixels, int samples, int bytes, char* out, std::string& problem);
 
 } // namespace rgmc
 
