@@ -902,8 +902,9 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   summary << "DICOM series " << chosenUID << " (" << (first.Modality.empty() ? "?" : first.Modality)
           << "): " << first.Columns << " x " << first.Rows << " x " << slices.size() << ", spacing "
           << Describe(spacing[0]) << " x " << Describe(spacing[1]) << " x " << Describe(spacing[2])
-          << " mm, transfer syntax " << first.TransferSyntaxUID << ", rescale "
-          << Describe(first.Slope) << " * stored + " << Describe(first.Intercept);
+          << " mm, transfer syntax " << TransferSyntaxName(first.TransferSyntaxUID) << ", rescale "
+          << Describe(first.Slope) << " * stored " << (first.Intercept < 0 ? "- " : "+ ")
+          << Describe(std::fabs(first.Intercept));
 
   rgmc::Packer p;
   p.Number(first.Columns).Number(first.Rows).Number(static_cast<double>(slices.size()));

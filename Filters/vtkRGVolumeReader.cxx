@@ -205,6 +205,39 @@ int vtkRGVolumeReader::RequestData(
   if (!empty)
   {
     output->GetPointData()->SetScalars(scalars);
+    // Mark the ghost layers the pipeline asked for, as ParaView's image sources do, so that
+    // filters know which cells this rank owns.
+    const int ghosts =
+      outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS());
+    if (ghosts > 0)
+    {
+      int whole[6], owned[6];
+      outInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+      const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+      const int pieces = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+      const int mode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+        ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+        : vtkExtentTranslator::BLOCK_MODE;
+      vtkNew<vtkExtentTranslator> translator;
+      translator->PieceToExtentThreadSafe(piece, pieces, 0, whole, owned, mode, 0);
+      bool consistent = true;
+      for (int a = 0; a < 3; ++a)
+      {
+        consistent = consistent && std::max(whole[2 * a], owned[2 * a] - ghosts) == extent[2 * a] &&
+          std::min(whole[2 * a + 1], owned[2 * a + 1] + ghosts) == extent[2 * a + 1];
+      }
+      if (!consistent)
+      {
+        // Not a piece of that split: the layers inside the whole extent are the ghosts.
+        for (int a = 0; a < 3; ++a)
+        {
+          owned[2 * a] = extent[2 * a] > whole[2 * a] ? extent[2 * a] + ghosts : extent[2 * a];
+          owned[2 * a + 1] =
+            extent[2 * a + 1] < whole[2 * a + 1] ? extent[2 * a + 1] - ghosts : extent[2 * a + 1];
+        }
+      }
+      output->GenerateGhostArray(owned);
+    }
   }
   return 1;
 }
