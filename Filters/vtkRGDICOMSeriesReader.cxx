@@ -392,6 +392,10 @@ bool CheckPixelFormat(const FileHeader& h, std::string& problem)
   {
     why << "has a PixelRepresentation of " << h.PixelRepresentation;
   }
+  else if (h.Samples == 3 && h.Planar != 0 && h.Planar != 1)
+  {
+    why << "has a PlanarConfiguration of " << h.Planar << " (0 or 1)";
+  }
   else if (!gdcm::TransferSyntax(static_cast<gdcm::TransferSyntax::TSType>(h.TransferSyntax))
               .IsValid())
   {
@@ -1076,6 +1080,30 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
       }
       else
       {
+        const int ts = in.TransferSyntax;
+        if (ts == gdcm::TransferSyntax::JPEGBaselineProcess1 ||
+          ts == gdcm::TransferSyntax::JPEGExtendedProcess2_4 ||
+          ts == gdcm::TransferSyntax::JPEGLosslessProcess14 ||
+          ts == gdcm::TransferSyntax::JPEGLosslessProcess14_1)
+        {
+          for (const auto& fragment : structure.Fragments)
+          {
+            std::string problem;
+            char start[2] = { 0, 0 };
+            std::ifstream file(slice.Path, std::ios::binary);
+            file.seekg(static_cast<std::streamoff>(fragment.first));
+            file.read(start, 2);
+            const bool frameStart = static_cast<unsigned char>(start[0]) == 0xff &&
+              static_cast<unsigned char>(start[1]) == 0xd8;
+            if ((frameStart || &fragment == &structure.Fragments.front()) &&
+              !rgmc::CheckJpegHeader(slice.Path, fragment.first, fragment.second, in.Rows,
+                in.Columns, samples, in.BitsStored, problem))
+            {
+              message = slice.Path + " has broken JPEG data: " + problem;
+              return false;
+            }
+          }
+        }
         // GDCM's parser and codecs, given the pixel description of the header scan (its
         // ImageReader also guesses geometry, and asserts on some valid files while doing so).
         gdcm::Reader reader;

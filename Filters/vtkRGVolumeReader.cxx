@@ -164,12 +164,17 @@ int vtkRGVolumeReader::RequestData(
   int extent[6];
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
   const bool empty = extent[0] > extent[1] || extent[2] > extent[3] || extent[4] > extent[5];
-  std::string message;
-  bool ok = this->OutputScalarType != 0;
-  if (!ok)
+  if (this->OutputScalarType == 0)
   {
-    message = "its header was not read (see the error before)";
+    // The header scan failed on every rank (its status was agreed): no collective here, since
+    // the pipeline may not call this on the ranks whose piece is then empty.
+    output->Initialize();
+    vtkErrorMacro(<< "Cannot read " << (this->FileName ? this->FileName : "(no file name)")
+                  << ": its header was not read (see the error before).");
+    return 0;
   }
+  std::string message;
+  bool ok = true;
   vtkSmartPointer<vtkDataArray> scalars;
   if (ok)
   {

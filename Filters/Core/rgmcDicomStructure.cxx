@@ -121,7 +121,15 @@ public:
     }
     e.VR[0] = static_cast<char>(b[4]);
     e.VR[1] = static_cast<char>(b[5]);
-    if (e.VR[0] < 'A' || e.VR[0] > 'Z' || e.VR[1] < 'A' || e.VR[1] > 'Z')
+    // GDCM asserts on a value representation it does not know: only DICOM's are accepted.
+    static const char known[] =
+      "AEASATCSDADSDTFLFDISLOLTOBODOFOLOVOWPNSHSLSQSSSTSVTMUCUIULUNURUSUTUV";
+    bool valid = false;
+    for (std::size_t v = 0; v + 1 < sizeof(known); v += 2)
+    {
+      valid = valid || (known[v] == e.VR[0] && known[v + 1] == e.VR[1]);
+    }
+    if (!valid)
     {
       return this->Fail(at, "an element has no valid value representation");
     }
@@ -361,6 +369,89 @@ bool Inflate(Source& s, std::uint64_t at, std::vector<unsigned char>& out)
 }
 
 } // namespace
+
+bool CheckJpegHeader(const std::string& path, std::uint64_t offset, std::uint64_t length, int rows,
+  int columns, int samples, int bits, std::string& problem)
+{
+  Source source(path);
+  std::vector<unsigned char> data(
+    static_cast<std::size_t>(std::min<std::uint64_t>(length, 1 << 20)));
+  if (!source.Read(offset, data.data(), data.size()))
+  {
+    problem = "a JPEG fragment past the end of the file";
+    return false;
+  }
+  const std::size_t n = data.size();
+  if (n < 4 || data[0] != 0xff || data[1] != 0xd8)
+  {
+    problem = "a JPEG frame that does not start with a start-of-image marker";
+    return false;
+  }
+  bool frame = false;
+  for (std::size_t at = 2; at < n;)
+  {
+    if (data[at] != 0xff)
+    {
+      problem = "a JPEG header with bytes outside a marker segment at " + std::to_string(at);
+      return false;
+    }
+    while (at < n && data[at] == 0xff)
+    {
+      ++at; // fill bytes
+    }
+    if (at + 2 >= n)
+    {
+      return true; // the header goes on in the next fragment: nothing more to check here
+    }
+    const unsigned char marker = data[at++];
+    if (marker == 0x00 || marker == 0xd8 || marker == 0xd9 || (marker >= 0xd0 && marker <= 0xd7))
+    {
+      problem = "a JPEG header with a misplaced marker";
+      return false;
+    }
+    const std::size_t size = (std::size_t(data[at]) << 8) | data[at + 1];
+    if (size < 2 || at + size > n)
+    {
+      problem = "a JPEG marker segment of " + std::to_string(size) + " bytes past its fragment";
+      return false;
+    }
+    const bool sof =
+      marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    if (sof)
+    {
+      if (frame || size < 8)
+      {
+        problem = "a JPEG stream with two frame headers, or a short one";
+        return false;
+      }
+      frame = true;
+      const int precision = data[at + 2];
+      const int height = (data[at + 3] << 8) | data[at + 4];
+      const int width = (data[at + 5] << 8) | data[at + 6];
+      const int components = data[at + 7];
+      if (height != rows || width != columns || components != samples || precision < 2 ||
+        precision > std::max(bits, 8) || size != 8 + 3 * std::size_t(components))
+      {
+        problem = "a JPEG frame of " + std::to_string(width) + " x " + std::to_string(height) +
+          " x " + std::to_string(components) + " samples of " + std::to_string(precision) +
+          " bits where the DICOM header says " + std::to_string(columns) + " x " +
+          std::to_string(rows) + " x " + std::to_string(samples);
+        return false;
+      }
+    }
+    if (marker == 0xda)
+    {
+      if (!frame)
+      {
+        problem = "a JPEG scan before any frame header";
+        return false;
+      }
+      return true;
+    }
+    at += size;
+  }
+  return true;
+}
 
 bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t length,
   std::size_t pixels, int samples, int bytes, char* out, std::string& problem)

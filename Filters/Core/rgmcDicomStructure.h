@@ -36,6 +36,13 @@ struct DicomStructure
 /// Walks the file at `path`.
 DicomStructure WalkDicom(const std::string& path);
 
+/// Checks the marker segments of a JPEG stream (ITU T.81) in the fragment at `offset`, up to its
+/// first scan: every segment's length within the fragment, one frame header whose size and
+/// components are `columns` x `rows` x `samples` with a precision of at most `bits`. GDCM's
+/// JPEG codec asserts on some broken streams instead of reporting them.
+bool CheckJpegHeader(const std::string& path, std::uint64_t offset, std::uint64_t length, int rows,
+  int columns, int samples, int bits, std::string& problem);
+
 /// Decodes one RLE Lossless frame (DICOM Part 5 Annex G), the fragment at `offset` of `length`
 /// bytes in `path`, into `out` (pixels * samples samples of `bytes` bytes each, interleaved, this
 /// host's byte order). False with `problem` when the frame is malformed.

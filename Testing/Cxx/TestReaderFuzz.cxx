@@ -180,7 +180,11 @@ int main(int argc, char* argv[])
       const std::string dir = work + "/" + std::to_string(tried);
       fs::create_directories(dir);
       const std::string path = dir + "/" + seed.Name;
-      Save(path, bytes);
+      Save(path, bytes); // left on disk if the reader crashes: the failing input
+      if (std::getenv("RGMC_FUZZ_VERBOSE"))
+      {
+        std::cout << "mutant " << tried << ": " << path << std::endl;
+      }
       vtkSmartPointer<vtkRGVolumeReader> reader;
       if (seed.Nifti)
       {
