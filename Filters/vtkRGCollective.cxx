@@ -43,6 +43,20 @@ bool Ranks::Any(bool flag)
   return any != 0;
 }
 
+void Ranks::Broadcast(std::string& text, int root)
+{
+  vtkIdType length = static_cast<vtkIdType>(text.size());
+  this->C->Broadcast(&length, 1, root);
+  if (this->Rank != root)
+  {
+    text.assign(static_cast<std::size_t>(length), '\0');
+  }
+  if (length > 0)
+  {
+    this->C->Broadcast(&text[0], length, root);
+  }
+}
+
 template <typename T>
 std::vector<std::vector<T>> Ranks::ExchangeAny(
   const std::vector<std::vector<T>>& outgoing, const std::vector<bool>& partners, int tag)
@@ -70,7 +84,8 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
     {
       continue;
     }
-    auto send = [&]() {
+    auto send = [&]()
+    {
       vtkIdType count = static_cast<vtkIdType>(outgoing[partner].size());
       this->C->Send(&count, 1, partner, tag);
       if (count > 0)
@@ -78,7 +93,8 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
         this->C->Send(outgoing[partner].data(), count, partner, tag + 1);
       }
     };
-    auto receive = [&]() {
+    auto receive = [&]()
+    {
       vtkIdType count = 0;
       this->C->Receive(&count, 1, partner, tag);
       incoming[partner].resize(static_cast<std::size_t>(count));

@@ -27,6 +27,9 @@ public:
   /// Whether `flag` holds on some rank.
   bool Any(bool flag);
 
+  /// Gives every rank the `text` of rank `root`.
+  void Broadcast(std::string& text, int root);
+
   /// Sends outgoing[r] to every rank r marked in `partners` (a symmetric relation) and returns
   /// what each sent back. Rounds follow a round-robin tournament, so every round is a perfect
   /// matching and blocking sends cannot deadlock; their number depends on the rank count only.
@@ -34,8 +37,8 @@ public:
     const std::vector<bool>& partners, int tag);
 
   /// Exchange for doubles.
-  std::vector<std::vector<double>> Exchange(const std::vector<std::vector<double>>& outgoing,
-    const std::vector<bool>& partners, int tag);
+  std::vector<std::vector<double>> Exchange(
+    const std::vector<std::vector<double>>& outgoing, const std::vector<bool>& partners, int tag);
 
   vtkMultiProcessController* C;
   const int Rank;

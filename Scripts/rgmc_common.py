@@ -136,9 +136,20 @@ def relaunch(script, argv, ranks, render):
     return subprocess.call(command, env=mpi_environment())
 
 
+def is_dicom_file(path):
+    """Whether `path` starts as a DICOM Part 10 file does (128 bytes, then "DICM")."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(132)[128:] == b"DICM"
+    except OSError:
+        return False
+
+
 def open_volume(spec):
-    """A ParaView source for `spec`: a file ParaView can read, or phantom:N (the CT phantom at
-    N^3) or phantom:NX,NY,NZ."""
+    """A ParaView source for `spec`: a DICOM series (a directory, or one file of the series:
+    the plugin's DICOM Series reader), a NIfTI-1 file (.nii, .nii.gz: the plugin's NIfTI Volume
+    reader), another file ParaView can read, or phantom:N (the CT phantom at N^3) or
+    phantom:NX,NY,NZ. The plugin's readers read a piece per rank."""
     from paraview import simple
     if spec.startswith("phantom:"):
         try:
@@ -153,10 +164,24 @@ def open_volume(spec):
         return simple.CTPhantom(Dimensions=dims)
     if not is_client() and not os.path.exists(spec):  # a server reads its own file system
         raise UsageError("no such file or directory: %s" % spec)
+    path = os.path.abspath(spec)
+    if os.path.isdir(path) or path.lower().endswith((".dcm", ".dicom")) or is_dicom_file(path):
+        return simple.DICOMSeries(FileName=path)
+    if path.lower().endswith((".nii", ".nii.gz")):
+        return simple.NIfTIVolume(FileName=path)
     source = simple.OpenDataFile(spec)
     if source is None:
         raise UsageError("ParaView has no reader for %s" % spec)
     return source
+
+
+def reader_summary(source):
+    """What the plugin's readers say they read (size, geometry, scaling), or None."""
+    try:
+        source.UpdatePropertyInformation()
+        return source.GetPropertyValue("Summary") or None
+    except (AttributeError, TypeError):
+        return None
 
 
 def image_summary(source):

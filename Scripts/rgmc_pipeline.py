@@ -9,6 +9,8 @@ reads the volume, grows the surface through the vertex nearest to each seed (Reg
 Marching Cubes, on --ranks MPI ranks), makes the pieces one watertight mesh and smooths it (Seam
 Repair), writes <output>.stl and <output>.vtp (one mesh, seam vertices merged) and
 <output>.json (what was done, the mesh checks, timings) and, with --screenshot, a picture.
+--input also takes a DICOM series (a directory, or one of its files) and a NIfTI-1 file
+(.nii, .nii.gz), read by the plugin's distributed readers (each rank reads its own slices).
 Rendering needs an X server (run under xvfb-run when there is no display).
 """
 
@@ -46,7 +48,9 @@ def parse_args(argv):
         "intensity between the tissue and the background, e.g. half the tissue's value. "
         "--input phantom:256 makes the project's CT phantom instead of reading a file.")
     parser.add_argument("--input", required=True,
-                        help="a volume ParaView can read (.vti, .mha, .nii, ...) or phantom:N")
+                        help="a DICOM series (a directory, or one of its files), a NIfTI-1 file "
+                        "(.nii, .nii.gz), another volume ParaView can read (.vti, .mha, ...), or "
+                        "phantom:N")
     parser.add_argument("--isovalue", type=float, required=True,
                         help="the surface's value, in the array's units (HU for CT)")
     parser.add_argument("--seed", type=parse_seed, action="append", default=[],
@@ -200,6 +204,10 @@ def main(argv):
     }
     print("input:      %s (%d x %d x %d, array %s, range %g to %g)" % (
         args.input, dims[0], dims[1], dims[2], array, value_range[0], value_range[1]))
+    summary = rgmc_common.reader_summary(volume)
+    if summary:
+        print("read:       %s" % summary)
+        report["reader"] = summary
     print("isovalue:   %g   mode: %s   ranks: %d%s" % (
         args.isovalue, args.mode, ranks, " (pvserver at %s)" % args.connect if args.connect else ""))
     for seed in args.seed:

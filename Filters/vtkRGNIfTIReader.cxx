@@ -1,0 +1,700 @@
+// The NIfTI-1 reader: the header on rank 0, broadcast; each rank seeks (.nii) or streams through
+// zlib (.nii.gz) to the bytes of its own slab.
+#include "vtkRGNIfTIReader.h"
+
+#include "vtkRGPacking.h"
+
+#include "vtkDataArray.h"
+#include "vtkMath.h"
+#include "vtkObjectFactory.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+#include <vector>
+
+vtkStandardNewMacro(vtkRGNIfTIReader);
+
+namespace
+{
+
+constexpr int HeaderSize = 348;
+
+/// A gzip stream (zlib reads an uncompressed file through the same calls), closed on scope exit.
+class GzFile
+{
+public:
+  explicit GzFile(const std::string& path)
+    : File(gzopen(path.c_str(), "rb"))
+  {
+    if (this->File)
+    {
+      gzbuffer(this->File, 1 << 17);
+    }
+  }
+  ~GzFile()
+  {
+    if (this->File)
+    {
+      gzclose(this->File);
+    }
+  }
+  GzFile(const GzFile&) = delete;
+  GzFile& operator=(const GzFile&) = delete;
+
+  /// Reads `count` bytes from `offset` on; returns how many it read (-1 on a zlib error).
+  long long Read(std::uint64_t offset, char* out, std::uint64_t count)
+  {
+    if (gzseek(this->File, static_cast<z_off_t>(offset), SEEK_SET) < 0)
+    {
+      return 0; // past the end of the data: nothing to read there
+    }
+    std::uint64_t done = 0;
+    while (done < count)
+    {
+      const unsigned chunk = static_cast<unsigned>(std::min<std::uint64_t>(count - done, 1u << 30));
+      const int got = gzread(this->File, out + done, chunk);
+      if (got < 0)
+      {
+        return -1;
+      }
+      if (got == 0)
+      {
+        break;
+      }
+      done += static_cast<std::uint64_t>(got);
+    }
+    return static_cast<long long>(done);
+  }
+  std::string Error()
+  {
+    int code = 0;
+    const char* text = gzerror(this->File, &code);
+    return text ? text : "unknown zlib error";
+  }
+
+  gzFile File;
+};
+
+void SwapBytes(char* data, int size)
+{
+  std::reverse(data, data + size);
+}
+
+/// The header fields the reader uses, in host byte order.
+struct Header
+{
+  bool Swap = false;
+  std::int16_t Dim[8] = {};
+  std::int16_t DataType = 0, BitPix = 0, QFormCode = 0, SFormCode = 0;
+  float PixDim[8] = {}, VoxOffset = 0, SclSlope = 0, SclInter = 0;
+  float Quatern[3] = {}, QOffset[3] = {}, SRow[3][4] = {};
+  char Magic[4] = {};
+};
+
+template <typename T>
+T Field(const char* raw, int offset, bool swap)
+{
+  T value;
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, raw + offset, sizeof(T));
+  if (swap)
+  {
+    SwapBytes(bytes, sizeof(T));
+  }
+  std::memcpy(&value, bytes, sizeof(T));
+  return value;
+}
+
+/// Parses a 348-byte header; false with `problem` when it is not a single-file NIfTI-1 header.
+bool ParseHeader(const char* raw, Header& h, std::string& problem)
+{
+  const std::int32_t size = Field<std::int32_t>(raw, 0, false);
+  const std::int32_t swapped = Field<std::int32_t>(raw, 0, true);
+  if (size == 540 || swapped == 540)
+  {
+    problem = "is a NIfTI-2 file: only NIfTI-1 is read";
+    return false;
+  }
+  if (size != HeaderSize && swapped != HeaderSize)
+  {
+    problem = "is not a NIfTI-1 file (its header size is " + std::to_string(size) + ", not 348)";
+    return false;
+  }
+  h.Swap = size != HeaderSize;
+  std::memcpy(h.Magic, raw + 344, 4);
+  if (std::memcmp(h.Magic, "ni1", 4) == 0)
+  {
+    problem = "is the header of a .hdr/.img pair: only single-file NIfTI (.nii, .nii.gz) is read";
+    return false;
+  }
+  if (std::memcmp(h.Magic, "n+1", 4) != 0)
+  {
+    problem = "has no NIfTI-1 magic 'n+1' (an Analyze 7.5 file?): only NIfTI-1 is read";
+    return false;
+  }
+  for (int d = 0; d < 8; ++d)
+  {
+    h.Dim[d] = Field<std::int16_t>(raw, 40 + 2 * d, h.Swap);
+    h.PixDim[d] = Field<float>(raw, 76 + 4 * d, h.Swap);
+  }
+  h.DataType = Field<std::int16_t>(raw, 70, h.Swap);
+  h.BitPix = Field<std::int16_t>(raw, 72, h.Swap);
+  h.VoxOffset = Field<float>(raw, 108, h.Swap);
+  h.SclSlope = Field<float>(raw, 112, h.Swap);
+  h.SclInter = Field<float>(raw, 116, h.Swap);
+  h.QFormCode = Field<std::int16_t>(raw, 252, h.Swap);
+  h.SFormCode = Field<std::int16_t>(raw, 254, h.Swap);
+  for (int a = 0; a < 3; ++a)
+  {
+    h.Quatern[a] = Field<float>(raw, 256 + 4 * a, h.Swap);
+    h.QOffset[a] = Field<float>(raw, 268 + 4 * a, h.Swap);
+    for (int c = 0; c < 4; ++c)
+    {
+      h.SRow[a][c] = Field<float>(raw, 280 + 16 * a + 4 * c, h.Swap);
+    }
+  }
+  return true;
+}
+
+/// Bytes per voxel and the VTK type of a NIfTI datatype; 0 when not read.
+int DataTypeSize(int datatype, int& vtkType)
+{
+  switch (datatype)
+  {
+    case 2:
+      vtkType = VTK_UNSIGNED_CHAR;
+      return 1;
+    case 256:
+      vtkType = VTK_SIGNED_CHAR;
+      return 1;
+    case 4:
+      vtkType = VTK_SHORT;
+      return 2;
+    case 512:
+      vtkType = VTK_UNSIGNED_SHORT;
+      return 2;
+    case 8:
+      vtkType = VTK_INT;
+      return 4;
+    case 768:
+      vtkType = VTK_UNSIGNED_INT;
+      return 4;
+    case 16:
+      vtkType = VTK_FLOAT;
+      return 4;
+    case 1024:
+      vtkType = VTK_LONG_LONG;
+      return 8;
+    case 1280:
+      vtkType = VTK_UNSIGNED_LONG_LONG;
+      return 8;
+    case 64:
+      vtkType = VTK_DOUBLE;
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+std::string DataTypeName(int datatype)
+{
+  switch (datatype)
+  {
+    case 32:
+      return "complex64";
+    case 128:
+      return "RGB24";
+    case 1536:
+      return "float128";
+    case 1792:
+      return "complex128";
+    case 2048:
+      return "complex256";
+    case 2304:
+      return "RGBA32";
+    default:
+      return "code " + std::to_string(datatype);
+  }
+}
+
+/// The stored value range of a VTK integer type.
+void IntegerRange(int vtkType, double& lo, double& hi)
+{
+  switch (vtkType)
+  {
+    case VTK_UNSIGNED_CHAR:
+      lo = 0, hi = 255;
+      break;
+    case VTK_SIGNED_CHAR:
+      lo = -128, hi = 127;
+      break;
+    case VTK_SHORT:
+      lo = -32768, hi = 32767;
+      break;
+    case VTK_UNSIGNED_SHORT:
+      lo = 0, hi = 65535;
+      break;
+    case VTK_INT:
+      lo = -2147483648.0, hi = 2147483647.0;
+      break;
+    case VTK_UNSIGNED_INT:
+      lo = 0, hi = 4294967295.0;
+      break;
+    default:
+      lo = -9.3e18, hi = 1.8e19;
+  }
+}
+
+template <typename T>
+double Value(const char* p, bool swap)
+{
+  return static_cast<double>(Field<T>(p, 0, swap));
+}
+
+/// One stored voxel as a double.
+double Voxel(const char* p, int vtkType, bool swap)
+{
+  switch (vtkType)
+  {
+    case VTK_UNSIGNED_CHAR:
+      return Value<std::uint8_t>(p, false);
+    case VTK_SIGNED_CHAR:
+      return Value<std::int8_t>(p, false);
+    case VTK_SHORT:
+      return Value<std::int16_t>(p, swap);
+    case VTK_UNSIGNED_SHORT:
+      return Value<std::uint16_t>(p, swap);
+    case VTK_INT:
+      return Value<std::int32_t>(p, swap);
+    case VTK_UNSIGNED_INT:
+      return Value<std::uint32_t>(p, swap);
+    case VTK_FLOAT:
+      return Value<float>(p, swap);
+    case VTK_LONG_LONG:
+      return Value<std::int64_t>(p, swap);
+    case VTK_UNSIGNED_LONG_LONG:
+      return Value<std::uint64_t>(p, swap);
+    default:
+      return Value<double>(p, swap);
+  }
+}
+
+std::string Describe(double v)
+{
+  char text[40];
+  std::snprintf(text, sizeof(text), "%.6g", v);
+  return text;
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+int vtkRGNIfTIReader::CanReadFile(const char* name)
+{
+  std::error_code error;
+  if (!name || !std::filesystem::is_regular_file(name, error))
+  {
+    return 0;
+  }
+  GzFile file(name);
+  char raw[HeaderSize];
+  Header h;
+  std::string problem;
+  return file.File && file.Read(0, raw, HeaderSize) == HeaderSize && ParseHeader(raw, h, problem)
+    ? 1
+    : 0;
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
+{
+  const std::string path = this->FileName;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+  {
+    message = std::filesystem::exists(path, error) ? "not a file" : "no such file";
+    return false;
+  }
+  GzFile file(path);
+  char raw[HeaderSize];
+  const long long got = file.File ? file.Read(0, raw, HeaderSize) : -1;
+  if (got < 0)
+  {
+    message = "cannot read its header (" + (file.File ? file.Error() : "cannot open") + ")";
+    return false;
+  }
+  if (got < HeaderSize)
+  {
+    message = "is truncated: its header has " + std::to_string(got) + " of 348 bytes";
+    return false;
+  }
+  Header h;
+  if (!ParseHeader(raw, h, message))
+  {
+    return false;
+  }
+  std::ostringstream warnings;
+
+  // Dimensions: x, y, z; a fourth and later dimension beyond 1 gives the first volume.
+  if (h.Dim[0] < 1 || h.Dim[0] > 7)
+  {
+    message = "has dim[0] = " + std::to_string(h.Dim[0]) + " (1 to 7 dimensions are valid)";
+    return false;
+  }
+  int dims[3] = { 1, 1, 1 };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (a < h.Dim[0])
+    {
+      dims[a] = h.Dim[a + 1];
+      if (dims[a] < 1)
+      {
+        message = "has dim[" + std::to_string(a + 1) + "] = " + std::to_string(dims[a]) +
+          ": dimensions must be at least 1";
+        return false;
+      }
+    }
+  }
+  long long volumes = 1;
+  for (int d = 4; d <= h.Dim[0]; ++d)
+  {
+    if (h.Dim[d] < 1)
+    {
+      message = "has dim[" + std::to_string(d) + "] = " + std::to_string(h.Dim[d]);
+      return false;
+    }
+    volumes *= h.Dim[d];
+  }
+  if (volumes > 1)
+  {
+    warnings << path << " holds " << volumes << " volumes: the first is read\n";
+  }
+  int vtkType = 0;
+  const int bytes = DataTypeSize(h.DataType, vtkType);
+  if (bytes == 0)
+  {
+    message = "has the datatype " + DataTypeName(h.DataType) +
+      ", which is not read (integers and real numbers of one component are)";
+    return false;
+  }
+  if (h.BitPix != 8 * bytes)
+  {
+    message = "has bitpix " + std::to_string(h.BitPix) + " for a datatype of " +
+      std::to_string(8 * bytes) + " bits";
+    return false;
+  }
+  if (!std::isfinite(h.VoxOffset) || h.VoxOffset < HeaderSize + 4 ||
+    h.VoxOffset != std::floor(h.VoxOffset))
+  {
+    message = "has vox_offset " + Describe(h.VoxOffset) + " (at least 352, a whole number)";
+    return false;
+  }
+  const std::uint64_t voxels = static_cast<std::uint64_t>(dims[0]) * dims[1] * dims[2];
+  const std::uint64_t needed = static_cast<std::uint64_t>(h.VoxOffset) + voxels * bytes;
+  const bool compressed = gzdirect(file.File) == 0;
+  if (!compressed)
+  {
+    const std::uint64_t size = std::filesystem::file_size(path, error);
+    if (!error && size < needed)
+    {
+      message = "is truncated: it has " + std::to_string(size) + " bytes, its header announces " +
+        std::to_string(needed) + " (" + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) +
+        " x " + std::to_string(dims[2]) + " voxels of " + std::to_string(bytes) +
+        " bytes from byte " + Describe(h.VoxOffset) + ")";
+      return false;
+    }
+  }
+
+  // Scaling: none when scl_slope is 0 or not finite (the standard's rule).
+  double slope = 1.0, intercept = 0.0;
+  if (std::isfinite(h.SclSlope) && h.SclSlope != 0)
+  {
+    slope = h.SclSlope;
+    intercept = std::isfinite(h.SclInter) ? h.SclInter : 0.0;
+  }
+  const bool integerData = vtkType != VTK_FLOAT && vtkType != VTK_DOUBLE;
+  double lo = 0, hi = 0;
+  IntegerRange(vtkType, lo, hi);
+  const bool integral =
+    integerData && slope == std::floor(slope) && intercept == std::floor(intercept);
+  const double a = slope * lo + intercept, b = slope * hi + intercept;
+  const int type = ChooseScalarType(integral, std::min(a, b), std::max(a, b),
+    vtkType == VTK_DOUBLE || (integerData && (hi - lo) > 16777216.0));
+
+  // Geometry: the voxel-to-world matrix M (RAS) and origin.
+  double m[3][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } }, origin[3] = { 0, 0, 0 };
+  int method = 1;
+  auto columnsOrthogonal = [](const double mm[3][3])
+  {
+    for (int p = 0; p < 3; ++p)
+    {
+      for (int q = p + 1; q < 3; ++q)
+      {
+        double dot = 0, np = 0, nq = 0;
+        for (int r = 0; r < 3; ++r)
+        {
+          dot += mm[r][p] * mm[r][q];
+          np += mm[r][p] * mm[r][p];
+          nq += mm[r][q] * mm[r][q];
+        }
+        if (np == 0 || nq == 0 || std::fabs(dot) > 1e-4 * std::sqrt(np * nq))
+        {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
+  double spacing[3];
+  for (int c = 0; c < 3; ++c)
+  {
+    spacing[c] = std::fabs(h.PixDim[c + 1]);
+    if (!std::isfinite(spacing[c]) || spacing[c] == 0)
+    {
+      spacing[c] = 1.0;
+    }
+  }
+  bool useS = h.SFormCode > 0;
+  if (useS)
+  {
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        m[r][c] = h.SRow[r][c];
+      }
+    }
+    if (!columnsOrthogonal(m))
+    {
+      if (h.QFormCode > 0)
+      {
+        warnings << path << " has a shearing (or degenerate) sform: its qform places the "
+                 << "volume\n";
+        useS = false;
+      }
+      else
+      {
+        message = "has an sform whose columns are not orthogonal (a shear) and no qform: "
+                  "the volume cannot be placed on a grid";
+        return false;
+      }
+    }
+  }
+  if (useS)
+  {
+    method = 3;
+    for (int r = 0; r < 3; ++r)
+    {
+      origin[r] = h.SRow[r][3];
+    }
+  }
+  else if (h.QFormCode > 0)
+  {
+    method = 2;
+    const double qb = h.Quatern[0], qc = h.Quatern[1], qd = h.Quatern[2];
+    double qa = 1.0 - (qb * qb + qc * qc + qd * qd);
+    qa = qa > 0 ? std::sqrt(qa) : 0.0;
+    const double qfac = h.PixDim[0] < 0 ? -1.0 : 1.0;
+    const double r[3][3] = { { qa * qa + qb * qb - qc * qc - qd * qd, 2 * (qb * qc - qa * qd),
+                               2 * (qb * qd + qa * qc) },
+      { 2 * (qb * qc + qa * qd), qa * qa + qc * qc - qb * qb - qd * qd, 2 * (qc * qd - qa * qb) },
+      { 2 * (qb * qd - qa * qc), 2 * (qc * qd + qa * qb), qa * qa + qd * qd - qc * qc - qb * qb } };
+    for (int row = 0; row < 3; ++row)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        m[row][c] = r[row][c] * spacing[c] * (c == 2 ? qfac : 1.0);
+      }
+      origin[row] = h.QOffset[row];
+    }
+  }
+  else
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      m[c][c] = spacing[c];
+    }
+    warnings << path << " has neither a qform nor an sform: placed at the origin with its "
+             << "pixdim spacing, axes as stored\n";
+  }
+  double direction[9];
+  for (int c = 0; c < 3; ++c)
+  {
+    const double length = std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]);
+    if (!(length > 0) || !std::isfinite(length))
+    {
+      message = "has a voxel-to-world matrix with a zero or invalid column " + std::to_string(c);
+      return false;
+    }
+    spacing[c] = length;
+    for (int r = 0; r < 3; ++r)
+    {
+      direction[3 * r + c] = m[r][c] / length;
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(origin[a]))
+    {
+      message = "has a non-finite origin";
+      return false;
+    }
+  }
+  if (method > 1)
+  {
+    // RAS to LPS: negate x and y of every world point.
+    for (int c = 0; c < 3; ++c)
+    {
+      direction[c] = -direction[c];
+      direction[3 + c] = -direction[3 + c];
+    }
+    origin[0] = -origin[0];
+    origin[1] = -origin[1];
+  }
+
+  std::ostringstream summary;
+  summary << "NIfTI-1 " << (compressed ? "(gzip) " : "") << dims[0] << " x " << dims[1] << " x "
+          << dims[2] << ", "
+          << (method == 3      ? "sform"
+                 : method == 2 ? "qform"
+                               : "pixdim")
+          << " geometry, spacing " << Describe(spacing[0]) << " x " << Describe(spacing[1]) << " x "
+          << Describe(spacing[2]) << " mm, scaling " << Describe(slope) << " * stored + "
+          << Describe(intercept);
+
+  rgmc::Packer p;
+  for (int a = 0; a < 3; ++a)
+  {
+    p.Number(dims[a]);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    p.Number(spacing[a]);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    p.Number(origin[a]);
+  }
+  for (double d : direction)
+  {
+    p.Number(d);
+  }
+  p.Number(type).Number(vtkType).Number(bytes).Number(h.Swap ? 1 : 0).Number(h.VoxOffset);
+  p.Number(slope).Number(intercept).Number(method);
+  p.String(warnings.str()).String(summary.str());
+  header = p.Text;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGNIfTIReader::Parse(const std::string& header, std::string& message)
+{
+  rgmc::Unpacker u(header);
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Dimensions[a] = u.Int();
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Spacing[a] = u.Number();
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Origin[a] = u.Number();
+  }
+  for (double& d : this->Direction)
+  {
+    d = u.Number();
+  }
+  this->OutputScalarType = u.Int();
+  this->DataType = u.Int();
+  this->BytesPerVoxel = u.Int();
+  this->Swap = u.Int() != 0;
+  this->VoxelOffset = u.Number();
+  this->RescaleSlope = u.Number();
+  this->RescaleIntercept = u.Number();
+  this->GeometryMethod = u.Int();
+  this->Warnings = u.String();
+  this->Summary = u.String();
+  this->NumberOfComponents = 1;
+  this->ArrayName = "Intensity";
+  if (!u.Ok())
+  {
+    this->OutputScalarType = 0;
+    message = "the header broadcast from rank 0 is damaged";
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGNIfTIReader::ReadExtent(const int extent[6], vtkDataArray* scalars, std::string& message)
+{
+  GzFile file(this->FileName);
+  if (!file.File)
+  {
+    message = "cannot open it to read its voxels";
+    return false;
+  }
+  const std::uint64_t nx = static_cast<std::uint64_t>(this->Dimensions[0]);
+  const std::uint64_t ny = static_cast<std::uint64_t>(this->Dimensions[1]);
+  const int bytes = this->BytesPerVoxel;
+  const int width = extent[1] - extent[0] + 1;
+  const int rows = extent[3] - extent[2] + 1;
+  std::vector<char> chunk(static_cast<std::size_t>(rows) * nx * bytes);
+  std::vector<double> values(static_cast<std::size_t>(width));
+  vtkIdType at = 0;
+  // PASS: slice by slice, the rows of the extent in one read each (increasing offsets, so a
+  // compressed stream is decompressed once up to the end of the slab).
+  for (int k = extent[4]; k <= extent[5]; ++k)
+  {
+    const std::uint64_t offset = static_cast<std::uint64_t>(this->VoxelOffset) +
+      ((static_cast<std::uint64_t>(k) * ny + extent[2]) * nx) * bytes;
+    const long long got = file.Read(offset, chunk.data(), chunk.size());
+    if (got < 0)
+    {
+      message = "its compressed data is corrupt near slice " + std::to_string(k) + " (" +
+        file.Error() + ")";
+      return false;
+    }
+    if (static_cast<std::uint64_t>(got) < chunk.size())
+    {
+      message = "is truncated: its voxel data ends in slice " + std::to_string(k) + " of " +
+        std::to_string(this->Dimensions[2]) + " (byte " +
+        std::to_string(offset + static_cast<std::uint64_t>(got)) + ")";
+      return false;
+    }
+    for (int j = 0; j < rows; ++j)
+    {
+      const char* row = chunk.data() + (static_cast<std::size_t>(j) * nx + extent[0]) * bytes;
+      for (int i = 0; i < width; ++i)
+      {
+        values[i] = this->RescaleSlope *
+            Voxel(row + static_cast<std::size_t>(i) * bytes, this->DataType, this->Swap) +
+          this->RescaleIntercept;
+      }
+      Store(scalars, at, values.data(), values.size());
+      at += width;
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkRGNIfTIReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "RescaleSlope: " << this->RescaleSlope << "\n";
+  os << indent << "RescaleIntercept: " << this->RescaleIntercept << "\n";
+  os << indent << "GeometryMethod: " << this->GeometryMethod << "\n";
+  os << indent << "VoxelOffset: " << this->VoxelOffset << "\n";
+  os << indent << "DataType: " << this->DataType << "\n";
+  os << indent << "BytesPerVoxel: " << this->BytesPerVoxel << "\n";
+  os << indent << "Swap: " << this->Swap << "\n";
+}

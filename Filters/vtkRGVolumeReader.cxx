@@ -1,0 +1,273 @@
+// The distributed reading shared by the plugin's volume readers: one header scan on rank 0,
+// broadcast; each rank reads its own slab; every status agreed over all ranks.
+#include "vtkRGVolumeReader.h"
+
+#include "vtkRGCollective.h"
+
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkDummyController.h"
+#include "vtkExtentTranslator.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
+#include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkShortArray.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+//------------------------------------------------------------------------------
+vtkRGVolumeReader::vtkRGVolumeReader()
+{
+  this->SetNumberOfInputPorts(0);
+  this->SetController(vtkMultiProcessController::GetGlobalController());
+}
+
+//------------------------------------------------------------------------------
+vtkRGVolumeReader::~vtkRGVolumeReader()
+{
+  this->SetFileName(nullptr);
+  this->SetController(nullptr);
+}
+
+//------------------------------------------------------------------------------
+void vtkRGVolumeReader::SetController(vtkMultiProcessController* controller)
+{
+  if (this->Controller == controller)
+  {
+    return;
+  }
+  if (this->Controller)
+  {
+    this->Controller->UnRegister(this);
+  }
+  this->Controller = controller;
+  if (controller)
+  {
+    controller->Register(this);
+  }
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+int vtkRGVolumeReader::ChooseScalarType(bool integral, double lo, double hi, bool wide)
+{
+  if (integral && lo >= VTK_SHORT_MIN && hi <= VTK_SHORT_MAX)
+  {
+    return VTK_SHORT;
+  }
+  return wide ? VTK_DOUBLE : VTK_FLOAT;
+}
+
+//------------------------------------------------------------------------------
+void vtkRGVolumeReader::Store(
+  vtkDataArray* scalars, vtkIdType at, const double* values, std::size_t count)
+{
+  // Every value is exact in the output type (ChooseScalarType), so a plain conversion is exact.
+  switch (scalars->GetDataType())
+  {
+    vtkTemplateMacro(
+      std::transform(values, values + count, static_cast<VTK_TT*>(scalars->GetVoidPointer(0)) + at,
+        [](double v) { return static_cast<VTK_TT>(v); }));
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkRGVolumeReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkNew<vtkDummyController> single;
+  rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
+
+  // PASS 1: the header scan, on rank 0, only when a property changed since the last one. Every
+  // rank takes the same branch: they all saw the same property changes.
+  if (this->GetMTime() > this->ScanTime || this->OutputScalarType == 0)
+  {
+    this->OutputScalarType = 0;
+    std::string header, message;
+    bool ok = true;
+    if (ranks.Rank == 0)
+    {
+      if (!this->FileName || !*this->FileName)
+      {
+        ok = false;
+        message = "no file name is set";
+      }
+      else
+      {
+        try
+        {
+          ok = this->Scan(header, message);
+        }
+        catch (const std::exception& e)
+        {
+          ok = false;
+          message = std::string(this->FileName) + ": " + e.what();
+        }
+      }
+    }
+    if (!ranks.Agree(ok, message))
+    {
+      vtkErrorMacro(<< "Cannot read " << (this->FileName ? this->FileName : "(no file name)")
+                    << ": " << message);
+      return 0;
+    }
+    // PASS 2: every rank learns the slice list and geometry from rank 0.
+    ranks.Broadcast(header, 0);
+    this->Warnings.clear();
+    if (!this->Parse(header, message))
+    {
+      // The same header gives the same result on every rank: no agreement needed.
+      vtkErrorMacro(<< "Cannot read " << this->FileName << ": " << message);
+      return 0;
+    }
+    std::istringstream warnings(this->Warnings);
+    for (std::string line; std::getline(warnings, line);)
+    {
+      vtkWarningMacro(<< line);
+    }
+    this->ScanTime.Modified();
+  }
+
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
+    this->Dimensions[2] - 1 };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
+  outInfo->Set(vtkDataObject::SPACING(), this->Spacing, 3);
+  outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
+  outInfo->Set(vtkDataObject::DIRECTION(), this->Direction, 9);
+  vtkDataObject::SetPointDataActiveScalarInfo(
+    outInfo, this->OutputScalarType, this->NumberOfComponents);
+  outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
+  // Slabs of whole slices: a rank then reads only the files (or the bytes) of its slices.
+  outInfo->Set(vtkExtentTranslator::UPDATE_SPLIT_MODE(), vtkExtentTranslator::Z_SLAB_MODE);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkRGVolumeReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkNew<vtkDummyController> single;
+  rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkImageData* output = vtkImageData::GetData(outInfo);
+
+  int extent[6];
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
+  const bool empty = extent[0] > extent[1] || extent[2] > extent[3] || extent[4] > extent[5];
+  if (this->OutputScalarType == 0)
+  {
+    // The header scan failed on every rank (its status was agreed): no collective here, since
+    // the pipeline may not call this on the ranks whose piece is then empty.
+    output->Initialize();
+    vtkErrorMacro(<< "Cannot read " << (this->FileName ? this->FileName : "(no file name)")
+                  << ": its header was not read (see the error before).");
+    return 0;
+  }
+  std::string message;
+  bool ok = true;
+  vtkSmartPointer<vtkDataArray> scalars;
+  if (ok)
+  {
+    output->SetExtent(extent);
+    output->SetSpacing(this->Spacing);
+    output->SetOrigin(this->Origin);
+    output->SetDirectionMatrix(this->Direction);
+  }
+  if (ok && !empty)
+  {
+    scalars.TakeReference(vtkDataArray::CreateDataArray(this->OutputScalarType));
+    scalars->SetName(this->ArrayName.c_str());
+    scalars->SetNumberOfComponents(this->NumberOfComponents);
+    scalars->SetNumberOfTuples(output->GetNumberOfPoints());
+    try
+    {
+      ok = this->ReadExtent(extent, scalars, message);
+    }
+    catch (const std::exception& e)
+    {
+      ok = false;
+      message = std::string(this->FileName) + ": " + e.what();
+    }
+  }
+  // A rank's read error (a truncated or undecodable file in its slab) fails every rank.
+  if (!ranks.Agree(ok, message))
+  {
+    output->Initialize();
+    vtkErrorMacro(<< "Cannot read " << (this->FileName ? this->FileName : "(no file name)") << ": "
+                  << message);
+    return 0;
+  }
+  if (!empty)
+  {
+    output->GetPointData()->SetScalars(scalars);
+    // Mark the ghost layers the pipeline asked for, as ParaView's image sources do, so that
+    // filters know which cells this rank owns.
+    const int ghosts =
+      outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS());
+    if (ghosts > 0)
+    {
+      int whole[6], owned[6];
+      outInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+      const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+      const int pieces = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+      const int mode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+        ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+        : vtkExtentTranslator::BLOCK_MODE;
+      vtkNew<vtkExtentTranslator> translator;
+      translator->PieceToExtentThreadSafe(piece, pieces, 0, whole, owned, mode, 0);
+      bool consistent = true;
+      for (int a = 0; a < 3; ++a)
+      {
+        consistent = consistent && std::max(whole[2 * a], owned[2 * a] - ghosts) == extent[2 * a] &&
+          std::min(whole[2 * a + 1], owned[2 * a + 1] + ghosts) == extent[2 * a + 1];
+      }
+      if (!consistent)
+      {
+        // Not a piece of that split: the layers inside the whole extent are the ghosts.
+        for (int a = 0; a < 3; ++a)
+        {
+          owned[2 * a] = extent[2 * a] > whole[2 * a] ? extent[2 * a] + ghosts : extent[2 * a];
+          owned[2 * a + 1] =
+            extent[2 * a + 1] < whole[2 * a + 1] ? extent[2 * a + 1] - ghosts : extent[2 * a + 1];
+        }
+      }
+      output->GenerateGhostArray(owned);
+    }
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkRGVolumeReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "Controller: " << this->Controller << "\n";
+  os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << " "
+     << this->Dimensions[2] << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " " << this->Origin[2]
+     << "\n";
+  os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1] << " "
+     << this->Spacing[2] << "\n";
+  os << indent << "Direction:";
+  for (double d : this->Direction)
+  {
+    os << " " << d;
+  }
+  os << "\n";
+  os << indent << "OutputScalarType: " << this->OutputScalarType << "\n";
+  os << indent << "NumberOfComponents: " << this->NumberOfComponents << "\n";
+  os << indent << "ArrayName: " << this->ArrayName << "\n";
+  os << indent << "Summary: " << this->Summary << "\n";
+  os << indent << "Warnings: " << this->Warnings << "\n";
+}

@@ -1,0 +1,169 @@
+// vtkRGDICOMSeriesReader on the real DICOM files that Debian's python3-pydicom ships (many
+// transfer syntaxes, both byte orders, signed and unsigned, 1 to 32 bits, RGB, multi-frame),
+// against pydicom's own decoding (Testing/Python/pydicom_oracle.py, run with Debian's python3):
+// every file pydicom decodes must decode to the same samples after the modality LUT, exactly.
+// Files pydicom cannot decode are listed with pydicom's reason; the reader must still read them
+// or fail with a message, never crash; the truncated one must be reported as truncated; files
+// without pixel data must be refused with a message.
+#include "rgmcReaderTestData.h"
+
+#include "vtkDummyController.h"
+#include "vtkRGDICOMSeriesReader.h"
+
+#include <cmath>
+#include <iostream>
+#include <map>
+
+using namespace rgmc_test;
+
+namespace
+{
+
+struct Entry
+{
+  std::string Name, Status, TransferSyntax, Note;
+  int Frames = 0, Rows = 0, Columns = 0, Samples = 0;
+};
+
+std::vector<Entry> Manifest(const std::string& path)
+{
+  std::vector<Entry> entries;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);)
+  {
+    std::vector<std::string> fields;
+    std::stringstream parts(line);
+    for (std::string f; std::getline(parts, f, '\t');)
+    {
+      fields.push_back(f);
+    }
+    fields.resize(5);
+    Entry e;
+    e.Name = fields[0];
+    e.Status = fields[1];
+    e.TransferSyntax = fields[2];
+    std::istringstream(fields[3]) >> e.Frames >> e.Rows >> e.Columns >> e.Samples;
+    e.Note = fields[4];
+    entries.push_back(e);
+  }
+  return entries;
+}
+
+std::vector<double> Samples(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::vector<double> values(static_cast<std::size_t>(in.tellg()) / sizeof(double));
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(values.data()),
+    static_cast<std::streamsize>(values.size() * sizeof(double)));
+  return values;
+}
+
+} // namespace
+
+int main()
+{
+  vtkNew<vtkDummyController> controller;
+  vtkMultiProcessController::SetGlobalController(controller);
+  const std::string work = ScratchDirectory(controller, "TestDICOMFiles");
+  const std::string oracle = work + "/pydicom";
+  if (!Run(std::string(RGMC_SYSTEM_PYTHON) + " " + RGMC_TESTING_PYTHON_DIR + "/pydicom_oracle.py " +
+        RGMC_PYDICOM_DIR + " " + oracle))
+  {
+    RGMC_CHECK(false, "the pydicom oracle failed");
+    return Result("TestDICOMFiles");
+  }
+  int compared = 0;
+  std::map<std::string, int> syntaxes;
+  std::vector<std::string> skipped;
+  for (const Entry& e : Manifest(oracle + "/manifest.tsv"))
+  {
+    // Each file alone in a directory: the reader reads the series of the file it is given.
+    const std::string dir = work + "/" + e.Name;
+    fs::create_directories(dir);
+    fs::copy_file(std::string(RGMC_PYDICOM_DIR) + "/" + e.Name, dir + "/" + e.Name,
+      fs::copy_options::overwrite_existing);
+    vtkNew<vtkRGDICOMSeriesReader> reader;
+    reader->SetController(controller);
+    reader->SetFileName((dir + "/" + e.Name).c_str());
+    PieceRead r = ReadPiece(reader, 0, 1, 0);
+    const std::string message = ReaderMessage(r.Errors);
+
+    if (e.Status == "decoded" || e.Status == "twin")
+    {
+      RGMC_CHECK(r.Ok, e.Name << " (" << e.TransferSyntax << "): not read: " << message);
+      if (!r.Ok)
+      {
+        continue;
+      }
+      int ext[6];
+      r.Image->GetExtent(ext);
+      vtkDataArray* ours = r.Image->GetPointData()->GetScalars();
+      const bool sameShape = ext[1] + 1 == e.Columns && ext[3] + 1 == e.Rows &&
+        ext[5] + 1 == e.Frames && ours->GetNumberOfComponents() == e.Samples;
+      RGMC_CHECK(sameShape,
+        e.Name << ": " << ext[1] + 1 << " x " << ext[3] + 1 << " x " << ext[5] + 1 << " x "
+               << ours->GetNumberOfComponents() << ", pydicom: " << e.Columns << " x " << e.Rows
+               << " x " << e.Frames << " x " << e.Samples);
+      if (!sameShape)
+      {
+        continue;
+      }
+      const std::vector<double> theirs = Samples(oracle + "/" + e.Name + ".f64");
+      vtkIdType differ = 0;
+      double worst = 0;
+      for (vtkIdType n = 0; n < static_cast<vtkIdType>(theirs.size()); ++n)
+      {
+        const double a = ours->GetComponent(n / e.Samples, static_cast<int>(n % e.Samples));
+        // Our float output holds pydicom's double exactly when it is exact in float.
+        const double b =
+          ours->GetDataType() == VTK_FLOAT ? static_cast<float>(theirs[n]) : theirs[n];
+        differ += a != b;
+        worst = std::max(worst, std::fabs(a - b));
+      }
+      RGMC_CHECK(differ == 0,
+        e.Name << " (" << e.TransferSyntax << "): " << differ << " of " << theirs.size()
+               << " samples differ from pydicom's, by up to " << worst);
+      ++compared;
+      ++syntaxes[e.TransferSyntax];
+      std::cout << "same as pydicom" << (e.Status == "twin" ? " (on its twin " + e.Note + ")" : "")
+                << ": " << e.Name << " " << e.TransferSyntax << " " << e.Columns << "x" << e.Rows
+                << "x" << e.Frames << "x" << e.Samples << " " << ours->GetDataTypeAsString()
+                << "\n";
+    }
+    else if (e.Status == "no-pixels")
+    {
+      RGMC_CHECK(!r.Ok &&
+          (message.find("no DICOM image") != std::string::npos ||
+            message.find("is truncated or corrupt") != std::string::npos),
+        e.Name << ": a file without pixel data gave [" << message << "]");
+    }
+    else
+    {
+      // No oracle: the reader reads it or says why not; it must not crash (reaching here).
+      skipped.push_back(e.Name + " (pydicom: " + e.Status + (e.Note.empty() ? "" : ", " + e.Note) +
+        "); our reader: " + (r.Ok ? "read it" : message));
+      RGMC_CHECK(r.Ok || !message.empty(), e.Name << ": failed without a message");
+      if (e.Name == "MR_truncated.dcm")
+      {
+        RGMC_CHECK(!r.Ok && message.find("is truncated") != std::string::npos &&
+            message.find(e.Name) != std::string::npos,
+          e.Name << ": expected a truncation error naming the file, got [" << message << "]");
+      }
+    }
+  }
+  std::cout << compared << " files decode exactly as pydicom decodes them, over " << syntaxes.size()
+            << " transfer syntaxes:";
+  for (const auto& s : syntaxes)
+  {
+    std::cout << " " << s.first << " (" << s.second << ")";
+  }
+  std::cout << "\nnot compared (no pydicom decoding):\n";
+  for (const std::string& s : skipped)
+  {
+    std::cout << "  " << s << "\n";
+  }
+  RGMC_CHECK(compared >= 40, "only " << compared << " files compared");
+  RGMC_CHECK(syntaxes.size() >= 8, "only " << syntaxes.size() << " transfer syntaxes compared");
+  return Result("TestDICOMFiles");
+}

@@ -1,0 +1,225 @@
+// A bounded mutation fuzz test of both readers over real files: pydicom's DICOM files (native
+// little and big endian, deflated, RLE, JPEG, JPEG-LS, JPEG 2000, multi-frame, 1-bit) and
+// mricron's MRI volume (as .nii and .nii.gz). Each mutant (random byte flips, interesting
+// values, truncations, inserted and deleted runs, mostly in the headers; a fixed seed, so every
+// run tries the same mutants) is read; the reader must come back (no crash, no hang) with a
+// volume or with an error that names the file. Runs in the plain and the sanitizer builds.
+//   TestReaderFuzz [mutants per file (default 100)] [seconds (default 150)]
+#include "rgmcReaderTestData.h"
+
+#include "vtkDummyController.h"
+#include "vtkRGDICOMSeriesReader.h"
+#include "vtkRGNIfTIReader.h"
+
+#include <zlib.h>
+
+#include <chrono>
+#include <iostream>
+#include <random>
+
+using namespace rgmc_test;
+
+namespace
+{
+
+std::vector<char> Load(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void Save(const std::string& path, const std::vector<char>& bytes)
+{
+  std::ofstream(path, std::ios::binary)
+    .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+/// One mutant of `bytes`: a few random edits, most of them in the first `focus` bytes.
+std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::size_t focus)
+{
+  auto position = [&]() -> std::size_t
+  {
+    if (bytes.empty())
+    {
+      return 0;
+    }
+    const std::size_t range = std::uniform_int_distribution<int>(0, 3)(random)
+      ? std::min(focus, bytes.size())
+      : bytes.size();
+    return std::uniform_int_distribution<std::size_t>(0, range - 1)(random);
+  };
+  const int edits = std::uniform_int_distribution<int>(1, 4)(random);
+  for (int e = 0; e < edits && !bytes.empty(); ++e)
+  {
+    switch (std::uniform_int_distribution<int>(0, 5)(random))
+    {
+      case 0: // flip bits
+        bytes[position()] ^=
+          static_cast<char>(1 << std::uniform_int_distribution<int>(0, 7)(random));
+        break;
+      case 1: // an interesting byte
+      {
+        static const char values[] = { 0, -1, 0x7f, -128, 1, 0x20 };
+        bytes[position()] = values[std::uniform_int_distribution<int>(0, 5)(random)];
+        break;
+      }
+      case 2: // an interesting 32-bit value (lengths, dimensions)
+      {
+        static const std::uint32_t values[] = { 0, 0xffffffffu, 0x7fffffffu, 0x80000000u, 0xfffe,
+          1u << 20 };
+        const std::uint32_t v = values[std::uniform_int_distribution<int>(0, 5)(random)];
+        const std::size_t at = position();
+        for (int b = 0; b < 4 && at + b < bytes.size(); ++b)
+        {
+          bytes[at + b] = static_cast<char>(v >> (8 * b));
+        }
+        break;
+      }
+      case 3: // truncate
+        bytes.resize(position());
+        break;
+      case 4: // delete a run
+      {
+        const std::size_t at = position();
+        const std::size_t n = std::min<std::size_t>(
+          bytes.size() - at, std::uniform_int_distribution<int>(1, 64)(random));
+        bytes.erase(bytes.begin() + at, bytes.begin() + at + n);
+        break;
+      }
+      default: // insert a copy of a run
+      {
+        const std::size_t from = position(), to = position();
+        const std::size_t n = std::min<std::size_t>(
+          bytes.size() - from, std::uniform_int_distribution<int>(1, 64)(random));
+        std::vector<char> run(bytes.begin() + from, bytes.begin() + from + n);
+        bytes.insert(bytes.begin() + std::min(to, bytes.size()), run.begin(), run.end());
+      }
+    }
+  }
+  return bytes;
+}
+
+std::vector<char> Gzip(const std::vector<char>& bytes)
+{
+  uLongf size = compressBound(static_cast<uLong>(bytes.size())) + 32;
+  std::vector<char> out(size);
+  z_stream z{};
+  deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  z.avail_in = static_cast<uInt>(bytes.size());
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.avail_out = static_cast<uInt>(out.size());
+  deflate(&z, Z_FINISH);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  return out;
+}
+
+std::vector<char> Gunzip(const std::string& path)
+{
+  std::vector<char> bytes;
+  gzFile in = gzopen(path.c_str(), "rb");
+  char chunk[1 << 16];
+  for (int got; (got = gzread(in, chunk, sizeof(chunk))) > 0;)
+  {
+    bytes.insert(bytes.end(), chunk, chunk + got);
+  }
+  gzclose(in);
+  return bytes;
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  const int perFile = argc > 1 ? std::atoi(argv[1]) : 100;
+  const double budget = argc > 2 ? std::atof(argv[2]) : 150.0;
+  vtkNew<vtkDummyController> controller;
+  vtkMultiProcessController::SetGlobalController(controller);
+  const std::string work = ScratchDirectory(controller, "TestReaderFuzz");
+  const std::string pydicom = RGMC_PYDICOM_DIR;
+  const std::vector<std::string> dicom = { "CT_small.dcm", "MR_small_bigendian.dcm",
+    "MR_small_RLE.dcm", "MR_small_jp2klossless.dcm", "MR_small_jpeg_ls_lossless.dcm",
+    "SC_rgb_jpeg_dcmtk.dcm", "SC_rgb_rle_16bit.dcm", "JPGExtended.dcm", "image_dfl.dcm",
+    "rtdose.dcm", "liver_1frame.dcm", "SC_ybr_full_422_uncompressed.dcm" };
+  struct Seed
+  {
+    std::string Name;
+    std::vector<char> Bytes;
+    bool Nifti, Gzip;
+  };
+  std::vector<Seed> seeds;
+  for (const std::string& name : dicom)
+  {
+    seeds.push_back(Seed{ name, Load(pydicom + "/" + name), false, false });
+  }
+  const std::vector<char> nifti =
+    Gunzip(std::string(RGMC_MRICRON_DIR) + "/JHU-WhiteMatter-labels-2mm.nii.gz");
+  seeds.push_back(Seed{ "labels.nii", nifti, true, false });
+  seeds.push_back(Seed{ "labels.nii.gz", nifti, true, true });
+
+  std::mt19937 random(20261122);
+  const auto start = std::chrono::steady_clock::now();
+  int tried = 0, read = 0, refused = 0;
+  bool outOfTime = false;
+  for (const Seed& seed : seeds)
+  {
+    for (int m = 0; m < perFile && !outOfTime; ++m)
+    {
+      // A NIfTI mutant of the .nii.gz is mutated before compression (the header and voxels
+      // matter; a broken gzip stream is also tried now and then).
+      std::vector<char> bytes = Mutate(seed.Bytes, random, seed.Nifti ? 352 : 2048);
+      if (seed.Gzip)
+      {
+        bytes = Gzip(bytes);
+        if (m % 5 == 0)
+        {
+          bytes = Mutate(bytes, random, bytes.size());
+        }
+      }
+      const std::string dir = work + "/" + std::to_string(tried);
+      fs::create_directories(dir);
+      const std::string path = dir + "/" + seed.Name;
+      Save(path, bytes); // left on disk if the reader crashes: the failing input
+      if (std::getenv("RGMC_FUZZ_VERBOSE"))
+      {
+        std::cout << "mutant " << tried << ": " << path << std::endl;
+      }
+      vtkSmartPointer<vtkRGVolumeReader> reader;
+      if (seed.Nifti)
+      {
+        reader = vtkSmartPointer<vtkRGNIfTIReader>::New();
+      }
+      else
+      {
+        reader = vtkSmartPointer<vtkRGDICOMSeriesReader>::New();
+      }
+      reader->SetController(controller);
+      reader->SetFileName(path.c_str());
+      PieceRead r = ReadPiece(reader, 0, 1, 0);
+      const std::string message = ReaderMessage(r.Errors);
+      if (r.Ok)
+      {
+        ++read;
+      }
+      else
+      {
+        ++refused;
+        RGMC_CHECK(message.find(path) != std::string::npos,
+          "mutant " << tried << " of " << seed.Name << ": an error without the file name: ["
+                    << r.Errors << "]");
+      }
+      fs::remove_all(dir);
+      ++tried;
+      outOfTime =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > budget;
+    }
+  }
+  const double seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << tried << " mutants of " << seeds.size() << " real files in " << seconds
+            << " s: " << read << " read, " << refused << " refused with a message naming the file"
+            << (outOfTime ? " (stopped at the time budget)" : "") << "\n";
+  RGMC_CHECK(tried >= 100, "only " << tried << " mutants tried in the time budget");
+  return Result("TestReaderFuzz");
+}
