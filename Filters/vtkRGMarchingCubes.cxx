@@ -756,19 +756,54 @@ int vtkRGMarchingCubes::RequestData(
     input->GetExtent(local);
     myCells = OwnedCells(input);
   }
-  std::vector<int> boxes(6 * ranks.Size);
+  // Each rank's owned cells (from its ghost array) and all its cells (its extent).
+  rgmc::CellBox allMine;
+  for (int a = 0; a < 3; ++a)
   {
-    const int mine[6] = { myCells.Lo[0], myCells.Lo[1], myCells.Lo[2], myCells.Hi[0],
-      myCells.Hi[1], myCells.Hi[2] };
-    ranks.C->AllGather(mine, boxes.data(), 6);
+    allMine.Lo[a] = local[2 * a];
+    allMine.Hi[a] = local[2 * a + 1] - 1;
   }
-  std::vector<rgmc::CellBox> cellBoxes(ranks.Size);
+  std::vector<int> boxes(12 * ranks.Size);
+  {
+    const int mine[12] = { myCells.Lo[0], myCells.Lo[1], myCells.Lo[2], myCells.Hi[0],
+      myCells.Hi[1], myCells.Hi[2], allMine.Lo[0], allMine.Lo[1], allMine.Lo[2], allMine.Hi[0],
+      allMine.Hi[1], allMine.Hi[2] };
+    ranks.C->AllGather(mine, boxes.data(), 12);
+  }
+  std::vector<rgmc::CellBox> cellBoxes(ranks.Size), extentBoxes(ranks.Size);
   for (int r = 0; r < ranks.Size; ++r)
   {
     for (int a = 0; a < 3; ++a)
     {
-      cellBoxes[r].Lo[a] = boxes[6 * r + a];
-      cellBoxes[r].Hi[a] = boxes[6 * r + 3 + a];
+      cellBoxes[r].Lo[a] = boxes[12 * r + a];
+      cellBoxes[r].Hi[a] = boxes[12 * r + 3 + a];
+      extentBoxes[r].Lo[a] = boxes[12 * r + 6 + a];
+      extentBoxes[r].Hi[a] = boxes[12 * r + 9 + a];
+    }
+  }
+  // Ghost markings that leave cells of a piece owned by no rank (a reader whose ghost arrays do
+  // not match its pieces) would silently lose the surface there. Then own by the extents: first
+  // without the one ghost layer asked for at faces inside the volume (the pipeline's
+  // convention), else whole, the lowest rank holding a cell owning it.
+  if (ranks.Any(!rgmc::Covers(cellBoxes, allMine)))
+  {
+    std::vector<rgmc::CellBox> trimmed = extentBoxes;
+    for (rgmc::CellBox& b : trimmed)
+    {
+      for (int a = 0; a < 3 && !b.Empty(); ++a)
+      {
+        b.Lo[a] += b.Lo[a] > whole[2 * a] ? 1 : 0;
+        b.Hi[a] -= b.Hi[a] < whole[2 * a + 1] - 1 ? 1 : 0;
+      }
+    }
+    const bool trimmedCovers = !ranks.Any(!rgmc::Covers(trimmed, allMine));
+    cellBoxes = trimmedCovers ? trimmed : extentBoxes;
+    if (ranks.Rank == 0)
+    {
+      vtkWarningMacro(<< "The input's ghost arrays mark cells that no rank owns (they do not match "
+                         "the pieces); cells are owned by the pieces' extents instead"
+                      << (trimmedCovers ? " less one ghost layer."
+                                        : ". Normals at the partition seams may be one-sided."));
     }
   }
   const rgmc::Ownership own(cellBoxes, ranks.Rank);

@@ -8,15 +8,16 @@
  *
  * Approach: a reader of this kind scans the headers once, on rank 0 of its controller, and
  * broadcasts the result (the sorted slice list, the geometry, the scaling) to every rank. It
- * advertises CAN_PRODUCE_SUB_EXTENT and asks the pipeline to split the volume into slabs of
- * slices, so each rank reads only the slices (and rows) of its own update extent.
+ * handles piece requests itself (CAN_HANDLE_PIECE_REQUEST): piece p of n is the p-th slab of
+ * whole slices (vtkExtentTranslator's Z_SLAB_MODE) plus the ghost layers asked for, marked as
+ * ghosts, so each rank reads only the slices of its own piece.
  *
  * Steps:
  * 1. RequestInformation, on every rank: rank 0 runs Scan(); its status is agreed over all
  *    ranks (an error on rank 0 becomes the same error on every rank), then its header is
  *    broadcast and every rank runs Parse() on it. The scan is repeated only when a property
  *    changed.
- * 2. RequestData, on every rank: ReadExtent() fills the rank's update extent; its status is
+ * 2. RequestData, on every rank: ReadExtent() fills the rank's piece; its status is
  *    agreed over all ranks before the reader returns, so one rank's truncated file fails every
  *    rank and none is left waiting in a later collective.
  *
@@ -96,6 +97,11 @@ protected:
    * volume). Returns false with `message` on error.
    */
   virtual bool ReadExtent(const int extent[6], vtkDataArray* scalars, std::string& message) = 0;
+
+  /// The extent of the piece the pipeline asks for (its slab of slices with the ghost layers,
+  /// within any requested update extent) and the part of it this rank owns; false when the
+  /// piece is empty.
+  bool PieceExtent(vtkInformation* outInfo, int extent[6], int owned[6]) const;
 
   /**
    * The output type for samples `slope * stored + intercept`: int16 when every such value is an

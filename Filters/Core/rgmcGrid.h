@@ -52,6 +52,66 @@ struct CellBox
   }
 };
 
+/// Whether every cell of `region` lies in at least one of `boxes`. Exact: the boxes that meet
+/// the region cut it into a grid of blocks (at their faces), and each block is checked once.
+inline bool Covers(const std::vector<CellBox>& boxes, const CellBox& region)
+{
+  if (region.Empty())
+  {
+    return true;
+  }
+  std::vector<CellBox> near;
+  std::vector<int> cuts[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    cuts[a] = { region.Lo[a], region.Hi[a] + 1 };
+  }
+  for (const CellBox& b : boxes)
+  {
+    const CellBox part = b.Intersect(region);
+    if (part.Empty())
+    {
+      continue;
+    }
+    near.push_back(part);
+    for (int a = 0; a < 3; ++a)
+    {
+      cuts[a].push_back(part.Lo[a]);
+      cuts[a].push_back(part.Hi[a] + 1);
+    }
+  }
+  for (auto& c : cuts)
+  {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+  }
+  for (std::size_t z = 0; z + 1 < cuts[2].size(); ++z)
+  {
+    for (std::size_t y = 0; y + 1 < cuts[1].size(); ++y)
+    {
+      for (std::size_t x = 0; x + 1 < cuts[0].size(); ++x)
+      {
+        // A block lies wholly inside or wholly outside each box: its first cell decides.
+        const int i = cuts[0][x], j = cuts[1][y], k = cuts[2][z];
+        bool inside = false;
+        for (const CellBox& b : near)
+        {
+          if (b.Contains(i, j, k))
+          {
+            inside = true;
+            break;
+          }
+        }
+        if (!inside)
+        {
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
 /// Point extents use VTK's order (x0, x1, y0, y1, z0, z1), inclusive.
 class Grid
 {

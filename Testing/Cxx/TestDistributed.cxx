@@ -5,8 +5,9 @@
 // a problem on one rank gives every rank the same message and an empty output.
 //
 // Decompositions: ParaView's block split (with a ghost layer), slabs along each axis, the whole
-// volume on rank 0 and nothing elsewhere, a rank with no data, and every rank holding the whole
-// volume (a reader that ignored the piece requests).
+// volume on rank 0 and nothing elsewhere, a rank with no data, every rank holding the whole
+// volume (a reader that ignored the piece requests), and slabs whose ghost arrays mark another
+// split's cells as owned (VTK 9.2's executive does that to readers that split in slabs).
 //
 // Fields: random blobs (many components), a helical tube and a wavy sheet that cross the
 // partition planes again and again, two blocks that meet only around the corner where 8 ranks
@@ -358,7 +359,19 @@ int main(int argc, char* argv[])
           }
           Run r = Extract(controller, image, field.Isovalue, mode,
             mode == vtkRGMarchingCubes::SEEDED ? field.SeedSets[s] : Seeds());
-          RGMC_CHECK(r.Errors.empty() && r.Warnings.empty(), what.str() << ": " << r.Errors << r.Warnings);
+          if (how == "mismarked")
+          {
+            // The ownership is repaired by the extents, and said so once.
+            const bool warned = r.Warnings.find("do not match the pieces") != std::string::npos &&
+              r.Warnings.find("less one ghost layer") != std::string::npos;
+            RGMC_CHECK(r.Errors.empty() && warned == (rank == 0) &&
+                r.Warnings.find("one-sided") == std::string::npos,
+              what.str() << ": " << r.Errors << r.Warnings);
+          }
+          else
+          {
+            RGMC_CHECK(r.Errors.empty() && r.Warnings.empty(), what.str() << ": " << r.Errors << r.Warnings);
+          }
           CompareUnion(controller, r.Output, rank == 0 ? &references[next] : nullptr, what.str());
           ++runs;
         }

@@ -77,5 +77,53 @@ int main()
       }
     }
   }
+
+  // Coverage, against counting cell by cell: random boxes, some overlapping, over a region.
+  {
+    std::uint32_t state = 12345;
+    auto next = [&state](int n) {
+      state = state * 1664525u + 1013904223u;
+      return static_cast<int>((state >> 8) % static_cast<std::uint32_t>(n));
+    };
+    for (int trial = 0; trial < 300; ++trial)
+    {
+      rgmc::CellBox region;
+      for (int a = 0; a < 3; ++a)
+      {
+        region.Lo[a] = next(3);
+        region.Hi[a] = region.Lo[a] + next(6);
+      }
+      std::vector<rgmc::CellBox> boxes(1 + next(6));
+      for (rgmc::CellBox& b : boxes)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          b.Lo[a] = next(8) - 1;
+          b.Hi[a] = b.Lo[a] + next(7) - 1; // sometimes empty
+        }
+      }
+      if (trial % 3 == 0)
+      {
+        boxes.push_back(region.Grown(next(2))); // sometimes the region is covered
+      }
+      bool expected = true;
+      for (int k = region.Lo[2]; k <= region.Hi[2]; ++k)
+      {
+        for (int j = region.Lo[1]; j <= region.Hi[1]; ++j)
+        {
+          for (int i = region.Lo[0]; i <= region.Hi[0]; ++i)
+          {
+            bool in = false;
+            for (const rgmc::CellBox& b : boxes)
+            {
+              in = in || b.Contains(i, j, k);
+            }
+            expected = expected && in;
+          }
+        }
+      }
+      RGMC_CHECK(rgmc::Covers(boxes, region) == expected, "Covers() in trial " << trial);
+    }
+  }
   return rgmc_test::Result("TestVertexKeys");
 }

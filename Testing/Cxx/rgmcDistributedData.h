@@ -16,11 +16,13 @@ using Seeds = std::vector<std::array<double, 3>>;
 /// Samples of a field over a point extent (with the field's spacing and origin).
 using FieldMaker = std::function<vtkSmartPointer<vtkImageData>(const int extent[6])>;
 
-/// What one rank holds in a decomposition: its owned points (empty box for none) and whether
-/// it gets a ghost layer (as the pipeline gives) or not (a reader that ignores requests).
+/// What one rank holds in a decomposition: its owned points (empty box for none), whether it
+/// gets a ghost layer (as the pipeline gives) or not (a reader that ignores requests), and the
+/// points its ghost array marks as owned (normally Owned; "mismarked" marks another split's).
 struct Piece
 {
   int Owned[6] = { 0, -1, 0, -1, 0, -1 };
+  int Marked[6] = { 0, -1, 0, -1, 0, -1 };
   bool Ghosts = true;
   bool Empty() const { return this->Owned[1] < this->Owned[0]; }
 };
@@ -31,7 +33,7 @@ inline std::vector<std::string> Decompositions(int ranks)
   {
     return { "block" };
   }
-  return { "block", "slab-x", "slab-y", "slab-z", "rank0", "empty-rank", "overlap" };
+  return { "block", "slab-x", "slab-y", "slab-z", "rank0", "empty-rank", "overlap", "mismarked" };
 }
 
 /// This rank's piece of `whole` (a point extent with the same number of cells on each axis).
@@ -76,6 +78,16 @@ inline Piece PieceOf(const std::string& how, const int whole[6], int rank, int r
     std::copy(whole, whole + 6, p.Owned);
     p.Ghosts = false;
   }
+  else if (how == "mismarked")
+  {
+    // Slabs along z whose ghost arrays mark the cells of slabs along x as owned, as VTK 9.2's
+    // executive marks them when a reader splits in slabs while the executive assumes blocks.
+    Piece z = PieceOf("slab-z", whole, rank, ranks), x = PieceOf("slab-x", whole, rank, ranks);
+    std::copy(z.Owned, z.Owned + 6, p.Owned);
+    std::copy(x.Owned, x.Owned + 6, p.Marked);
+    return p;
+  }
+  std::copy(p.Owned, p.Owned + 6, p.Marked);
   return p;
 }
 
@@ -91,7 +103,7 @@ inline vtkSmartPointer<vtkImageData> MakePiece(
   vtkSmartPointer<vtkImageData> image = make(extent);
   if (piece.Ghosts)
   {
-    MarkGhostCells(image, piece.Owned);
+    MarkGhostCells(image, piece.Marked);
   }
   return image;
 }
