@@ -185,9 +185,15 @@ public:
     const CellBox& box = this->Own.Mine();
     if (!box.Empty())
     {
-      this->BoxNx = box.Hi[0] - box.Lo[0] + 1;
-      this->BoxNxy = this->BoxNx * (box.Hi[1] - box.Lo[1] + 1);
-      this->Visited.Allocate(static_cast<std::size_t>((box.Count() + 63) / 64));
+      // Visited bits in tiles of 32^3 cubes (4 KiB, one page), each tile in words of 4^3 cubes:
+      // a small surface touches a few pages, whatever the size of the volume.
+      std::int64_t tiles = 1;
+      for (int a = 0; a < 3; ++a)
+      {
+        this->Tiles[a] = ((box.Hi[a] - box.Lo[a] + 1) + TileCubes - 1) / TileCubes;
+        tiles *= this->Tiles[a];
+      }
+      this->Visited.Allocate(static_cast<std::size_t>(tiles * TileWords));
     }
     for (int v = 0; v < 8; ++v)
     {
@@ -421,7 +427,24 @@ public:
     {
       return;
     }
-    const CellBox& box = this->Own.Mine();
+    // The box of the nodes' cubes: the slabs and the edge tables cover only it, so that a small
+    // surface costs the same in any volume (no plane-sized tables to touch).
+    CellBox& box = this->NodeBox;
+    box = CellBox();
+    for (int a = 0; a < 3; ++a)
+    {
+      box.Lo[a] = std::numeric_limits<int>::max();
+      box.Hi[a] = std::numeric_limits<int>::min();
+    }
+    for (const Node& n : this->Nodes)
+    {
+      const int c[3] = { n.I, n.J, n.K };
+      for (int a = 0; a < 3; ++a)
+      {
+        box.Lo[a] = std::min(box.Lo[a], c[a]);
+        box.Hi[a] = std::max(box.Hi[a], c[a]);
+      }
+    }
     const int numSlabs = box.Hi[2] - box.Lo[2] + 1;
 
     // Nodes by slab (a counting sort on k).
@@ -469,7 +492,7 @@ public:
 
     // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,
     // z edges inside it. The top plane becomes the next slab's bottom.
-    this->LayerNx = this->BoxNx + 1;
+    this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
     const std::size_t planeSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
     for (auto& layer : this->Layers)
     {
@@ -842,10 +865,16 @@ private:
 
   // ---- phase 1 internals ---------------------------------------------------------------------
 
+  /// The bit of an owned cube: tile (32^3 cubes), then word (4^3 cubes) in the tile, then cube.
   std::int64_t BoxIndex(int i, int j, int k) const
   {
     const CellBox& b = this->Own.Mine();
-    return (i - b.Lo[0]) + this->BoxNx * (j - b.Lo[1]) + this->BoxNxy * (k - b.Lo[2]);
+    const int x = i - b.Lo[0], y = j - b.Lo[1], z = k - b.Lo[2];
+    const std::int64_t tile =
+      (x >> 5) + this->Tiles[0] * ((y >> 5) + std::int64_t(this->Tiles[1]) * (z >> 5));
+    const int word = ((x >> 2) & 7) + 8 * (((y >> 2) & 7) + 8 * ((z >> 2) & 7));
+    const int bit = (x & 3) + 4 * ((y & 3) + 4 * (z & 3));
+    return (tile * TileWords + word) * 64 + bit;
   }
 
   bool Done(std::int64_t bit) const { return (this->Visited[bit >> 6] >> (bit & 63)) & 1u; }
@@ -1248,7 +1277,7 @@ private:
     int p[3];
     this->EdgeLowPoint(n.I, n.J, n.K, e, p);
     const int axis = this->EdgeAxisOf[e];
-    const CellBox& box = this->Own.Mine();
+    const CellBox& box = this->NodeBox;
     const std::int32_t index =
       static_cast<std::int32_t>((p[0] - box.Lo[0]) + this->LayerNx * (p[1] - box.Lo[1]));
     Layer* layer = axis == 2 ? this->Vertical : this->Slab[p[2] - this->SlabK][axis];
@@ -1378,7 +1407,9 @@ private:
   int CentralLo[3], CentralHi[3];
   int InnerLo[3], InnerHi[3];
 
-  std::int64_t BoxNx = 0, BoxNxy = 0;
+  static constexpr int TileCubes = 32;  // cubes along each axis of a tile of visited bits
+  static constexpr int TileWords = 512; // 64-bit words in a tile
+  std::int64_t Tiles[3] = { 0, 0, 0 };  // tiles along each axis of the owned box
   ZeroedArray<std::uint64_t> Visited; // a bit per owned cube: its nodes were all found
   KeyMap MultiGroup{ 64 };
   std::vector<Node> Nodes;
@@ -1389,6 +1420,7 @@ private:
   Layer* Vertical = nullptr;
   int SlabK = 0;
   std::int64_t LayerNx = 0;
+  CellBox NodeBox; // the cubes of the nodes, during extraction
   KeyMap PointVertices{ 64 };
 
   std::int64_t JoinCount = 0;
