@@ -160,7 +160,7 @@ def plots(rows, args, output):
         ax.set_xscale("log", base=2)
         ax.set_yscale("log")
         ax.set_xlabel("volume size N (N^3 voxels); the same sphere of 5424 triangles")
-        ax.set_ylabel("seconds (min of %d), 1 rank" % args.sweep_repeats)
+        ax.set_ylabel("seconds (min of at least %d runs), 1 rank" % args.sweep_repeats)
         ax.set_title("Time against volume size at a fixed surface")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
@@ -181,7 +181,7 @@ def plots(rows, args, output):
         ax.set_xticks([x + width * (len(args.ranks) - 1) / 2 for x in range(len(methods))])
         ax.set_xticklabels([NAMES[m].replace("*", "").replace(" (ours)", "\n(ours)").replace(" (the", "\n(the")
                             for m in methods], fontsize=7)
-        ax.set_ylabel("seconds (min of %d)" % args.repeats)
+        ax.set_ylabel("seconds (min of at least %d runs)" % args.repeats)
         ax.set_title(CASES.get(case, case))
         ax.legend()
         fig.tight_layout()
@@ -195,8 +195,8 @@ def report(rows, args, pictures):
     cores = os.cpu_count() or 1
     header = ["%d rank%s%s" % (r, "s" if r > 1 else "", "*" if r > cores else "") for r in args.ranks]
     lines = ["# RGMC evaluation", "",
-             "Machine: %s. Date: %s. One process set of %d MPI processes; %d repeats (sweep: %d); "
-             "times are the slowest rank's, in seconds, min (median). %s" % (
+             "Machine: %s. Date: %s. One process set of %d MPI processes; at least %d runs of each method (sweep: %d), "
+             "more of a short one (until 0.5 s or 100 runs); times are the slowest rank's, in seconds, min (median). %s" % (
                  machine(), datetime.date.today().isoformat(), max(args.ranks), args.repeats,
                  args.sweep_repeats,
                  "`*`: more ranks than cores (oversubscribed): those times measure correctness "
@@ -258,7 +258,7 @@ def report(rows, args, pictures):
         sizes = sorted(set(r["dims"][0] for r in sweep))
         lines += ["## Time against volume size at a fixed surface", "",
                   "The same sphere (radius 12 voxels, 5424 triangles, fixed place) in N^3 voxels of "
-                  "empty space, 1 rank, seconds (min of %d):" % args.sweep_repeats, "",
+                  "empty space, 1 rank, seconds (min of at least %d runs):" % args.sweep_repeats, "",
                   "| method | " + " | ".join("%d^3" % n for n in sizes) + " |", "|---|" + "---|" * len(sizes)]
         for method in ("seeded", "fe", "contour"):
             cells = []
