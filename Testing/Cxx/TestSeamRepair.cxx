@@ -9,6 +9,7 @@
 #include "rgmcDistributedData.h"
 #include "rgmcTestData.h"
 
+#include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"
 #include "vtkDummyController.h"
 #include "vtkExtractVOI.h"
@@ -312,6 +313,52 @@ void BadInput(vtkMultiProcessController* controller)
   }
 }
 
+/// An abort on the last rank during smoothing: every rank stops, with an empty output, and
+/// nothing hangs.
+void Abort(vtkMultiProcessController* controller)
+{
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  const Surface& surface = Surfaces().front();
+  vtkSmartPointer<vtkImageData> image =
+    MakePiece(surface.Make, Whole, PieceOf("block", Whole, rank, ranks));
+  vtkSmartPointer<vtkPolyData> extracted =
+    Extract(controller, image, surface.Isovalue, surface.Mode, surface.SeedPoints).Output;
+  vtkNew<vtkRGSeamRepair> repair;
+  repair->SetController(controller);
+  repair->SetInputData(extracted);
+  repair->SetNumberOfIterations(200);
+  vtkNew<vtkCallbackCommand> abort;
+  abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
+    vtkAlgorithm* algorithm = static_cast<vtkAlgorithm*>(caller);
+    if (algorithm->GetProgress() > 0.5)
+    {
+      algorithm->SetAbortExecute(1);
+    }
+  });
+  if (rank == ranks - 1)
+  {
+    repair->AddObserver(vtkCommand::ProgressEvent, abort);
+  }
+  repair->Update();
+  long long cells = repair->GetOutput()->GetNumberOfCells(), total = 0;
+  controller->AllReduce(&cells, &total, 1, vtkCommunicator::SUM_OP);
+  RGMC_CHECK(total == 0, "an abort on the last rank left " << total << " triangles");
+
+  // The same filter, no longer aborted, repairs again.
+  repair->RemoveAllObservers();
+  repair->SetAbortExecute(0);
+  repair->Modified();
+  repair->Update();
+  cells = repair->GetOutput()->GetNumberOfCells();
+  controller->AllReduce(&cells, &total, 1, vtkCommunicator::SUM_OP);
+  RGMC_CHECK(total > 0 && Field(repair->GetOutput(), "Closed") == 1,
+    "after an abort, the next update gives " << total << " triangles");
+  if (rank == 0)
+  {
+    std::cout << "abort on rank " << ranks - 1 << " during smoothing: every rank stopped\n";
+  }
+}
+
 } // namespace
 
 int main(int argc, char* argv[])
@@ -437,6 +484,7 @@ int main(int argc, char* argv[])
     }
   }
   BadInput(controller);
+  Abort(controller);
 
   long long failures = rgmc_test::Failures(), total = 0;
   controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
