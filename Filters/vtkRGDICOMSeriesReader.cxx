@@ -911,17 +911,16 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
           << Describe(std::fabs(first.Intercept));
 
   rgmc::Packer p;
-  p.Number(first.Columns).Number(first.Rows).Number(static_cast<double>(slices.size()));
-  p.Number(spacing[0]).Number(spacing[1]).Number(spacing[2]);
-  for (double x : origin)
-  {
-    p.Number(x);
-  }
+  const int dimensions[3] = { first.Columns, first.Rows, static_cast<int>(slices.size()) };
+  double direction[9]; // row-major 3x3, columns row/col/normal
   for (int a = 0; a < 3; ++a)
   {
-    p.Number(row[a]).Number(col[a]).Number(normal[a]); // row-major 3x3, columns row/col/normal
+    direction[3 * a] = row[a];
+    direction[3 * a + 1] = col[a];
+    direction[3 * a + 2] = normal[a];
   }
-  p.Number(type).Number(first.Samples).Number(first.Planar).Number(first.BitsAllocated);
+  PackGeometry(p, dimensions, spacing, origin, direction, type);
+  p.Number(first.Samples).Number(first.Planar).Number(first.BitsAllocated);
   p.Number(first.BitsStored).Number(first.PixelRepresentation).Number(first.TransferSyntax);
   p.Number(deviation).Number(static_cast<double>(files.size()));
   p.String(isCT ? "HU" : "Intensity").String(list.str()).String(warnings.str());
@@ -940,23 +939,7 @@ bool vtkRGDICOMSeriesReader::Parse(const std::string& header, std::string& messa
 {
   rgmc::Unpacker u(header);
   Internals& in = *this->Internal;
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Dimensions[a] = u.Int();
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Spacing[a] = u.Number();
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Origin[a] = u.Number();
-  }
-  for (double& d : this->Direction)
-  {
-    d = u.Number();
-  }
-  this->OutputScalarType = u.Int();
+  this->UnpackGeometry(u);
   in.Samples = u.Int();
   in.Planar = u.Int();
   in.BitsAllocated = u.Int();

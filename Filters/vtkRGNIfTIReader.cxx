@@ -569,23 +569,8 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
           << Describe(intercept);
 
   rgmc::Packer p;
-  for (int a = 0; a < 3; ++a)
-  {
-    p.Number(dims[a]);
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    p.Number(spacing[a]);
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    p.Number(origin[a]);
-  }
-  for (double d : direction)
-  {
-    p.Number(d);
-  }
-  p.Number(type).Number(vtkType).Number(bytes).Number(h.Swap ? 1 : 0).Number(h.VoxOffset);
+  PackGeometry(p, dims, spacing, origin, direction, type);
+  p.Number(vtkType).Number(bytes).Number(h.Swap ? 1 : 0).Number(h.VoxOffset);
   p.Number(slope).Number(intercept).Number(method);
   p.String(warnings.str()).String(summary.str());
   header = p.Text;
@@ -596,23 +581,7 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
 bool vtkRGNIfTIReader::Parse(const std::string& header, std::string& message)
 {
   rgmc::Unpacker u(header);
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Dimensions[a] = u.Int();
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Spacing[a] = u.Number();
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Origin[a] = u.Number();
-  }
-  for (double& d : this->Direction)
-  {
-    d = u.Number();
-  }
-  this->OutputScalarType = u.Int();
+  this->UnpackGeometry(u);
   this->DataType = u.Int();
   this->BytesPerVoxel = u.Int();
   this->Swap = u.Int() != 0;

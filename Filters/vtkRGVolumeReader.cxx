@@ -3,6 +3,7 @@
 #include "vtkRGVolumeReader.h"
 
 #include "vtkRGCollective.h"
+#include "vtkRGPacking.h"
 
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
@@ -284,4 +285,49 @@ void vtkRGVolumeReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ArrayName: " << this->ArrayName << "\n";
   os << indent << "Summary: " << this->Summary << "\n";
   os << indent << "Warnings: " << this->Warnings << "\n";
+}
+
+//------------------------------------------------------------------------------
+void vtkRGVolumeReader::PackGeometry(rgmc::Packer& p, const int dimensions[3],
+  const double spacing[3], const double origin[3], const double direction[9], int scalarType)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    p.Number(dimensions[a]);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    p.Number(spacing[a]);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    p.Number(origin[a]);
+  }
+  for (int i = 0; i < 9; ++i)
+  {
+    p.Number(direction[i]);
+  }
+  p.Number(scalarType);
+}
+
+//------------------------------------------------------------------------------
+void vtkRGVolumeReader::UnpackGeometry(rgmc::Unpacker& u)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Dimensions[a] = u.Int();
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Spacing[a] = u.Number();
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Origin[a] = u.Number();
+  }
+  for (double& d : this->Direction)
+  {
+    d = u.Number();
+  }
+  this->OutputScalarType = u.Int();
 }

@@ -38,6 +38,12 @@
 
 #include <string> // For std::string
 
+namespace rgmc
+{
+class Packer;
+class Unpacker;
+}
+
 class vtkDataArray;
 class vtkMultiProcessController;
 
@@ -110,6 +116,15 @@ protected:
    * otherwise.
    */
   static int ChooseScalarType(bool integral, double lo, double hi, bool wide);
+
+  /**
+   * The geometry and sample type, in the order every header starts with: Scan writes them with
+   * PackGeometry (direction row-major), Parse reads them into the members below with
+   * UnpackGeometry.
+   */
+  static void PackGeometry(rgmc::Packer& p, const int dimensions[3], const double spacing[3],
+    const double origin[3], const double direction[9], int scalarType);
+  void UnpackGeometry(rgmc::Unpacker& u);
 
   /// Writes `count` values into `scalars` (of OutputScalarType) from tuple component `at`.
   static void Store(vtkDataArray* scalars, vtkIdType at, const double* values, std::size_t count);

@@ -8,10 +8,10 @@
 // naming the file and the problem, on every rank; irregular spacing and a second series give
 // warnings and the volume is still read.
 #include "rgmcReaderTestData.h"
+#include "rgmcTestController.h"
 
 #include "vtkDummyController.h"
 #include "vtkExtentTranslator.h"
-#include "vtkMPIController.h"
 #include "vtkMatrix3x3.h"
 #include "vtkRGDICOMSeriesReader.h"
 
@@ -371,18 +371,7 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
 
 int main(int argc, char* argv[])
 {
-  const bool dummy = argc > 1 && std::string(argv[1]) == "--dummy";
-  vtkSmartPointer<vtkMultiProcessController> controller;
-  if (dummy)
-  {
-    controller = vtkSmartPointer<vtkDummyController>::New();
-  }
-  else
-  {
-    controller = vtkSmartPointer<vtkMPIController>::New();
-  }
-  controller->Initialize(&argc, &argv);
-  vtkMultiProcessController::SetGlobalController(controller);
+  vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
 
   const int wholeExtent[6] = { 0, Dims[0] - 1, 0, Dims[1] - 1, 0, Dims[2] - 1 };

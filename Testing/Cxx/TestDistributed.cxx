@@ -14,6 +14,7 @@
 // meet, two bars that meet only along the edge where 4 ranks meet, and the CT phantom (with
 // spacing and origin).
 #include "rgmcDistributedData.h"
+#include "rgmcTestController.h"
 #include "rgmcTestData.h"
 
 #include "vtkCallbackCommand.h"
@@ -22,7 +23,6 @@
 #include "vtkFieldData.h"
 #include "vtkIdTypeArray.h"
 #include "vtkIntArray.h"
-#include "vtkMPIController.h"
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGPhantomSource.h"
 
@@ -66,7 +66,8 @@ std::vector<Field> Fields()
   // A tube of radius 2.2 coiled around the z axis (radius 10, pitch 6): it crosses every
   // partition plane again and again.
   fields.push_back(IndexField("helix", VTK_DOUBLE,
-    [](int i, int j, int k) {
+    [](int i, int j, int k)
+    {
       const double x = i - 16.0, y = j - 16.0;
       const double rho = std::sqrt(x * x + y * y), theta = std::atan2(y, x);
       double dz = k - 6.0 * theta / (2 * Pi);
@@ -77,7 +78,8 @@ std::vector<Field> Fields()
 
   // A wavy sheet that winds back and forth across the planes x = 16, y = 16 and z = 16.
   fields.push_back(IndexField("comb", VTK_FLOAT,
-    [](int i, int j, int k) {
+    [](int i, int j, int k)
+    {
       return (i - 16.0) - 6.0 * std::sin(2 * Pi * j / 7.3) * std::cos(2 * Pi * k / 9.1) -
         3.0 * std::sin(2 * Pi * k / 5.3);
     },
@@ -86,10 +88,12 @@ std::vector<Field> Fields()
   // Two blocks of inside samples, one in the octant above the centre (16, 16, 16) and one
   // below it, sharing only the centre: where 8 ranks meet in a 2 x 2 x 2 split.
   fields.push_back(IndexField("corner", VTK_UNSIGNED_CHAR,
-    [](int i, int j, int k) {
+    [](int i, int j, int k)
+    {
       const int d[3] = { i - 16, j - 16, k - 16 };
       const bool above = d[0] >= 0 && d[1] >= 0 && d[2] >= 0 && d[0] <= 5 && d[1] <= 5 && d[2] <= 5;
-      const bool below = d[0] <= 0 && d[1] <= 0 && d[2] <= 0 && d[0] >= -5 && d[1] >= -5 && d[2] >= -5;
+      const bool below =
+        d[0] <= 0 && d[1] <= 0 && d[2] <= 0 && d[0] >= -5 && d[1] >= -5 && d[2] >= -5;
       return above || below ? 2.0 : 0.0;
     },
     1.0, { { { 20.0, 20.0, 20.0 } }, { { 16.0, 16.0, 16.0 } } }));
@@ -97,7 +101,8 @@ std::vector<Field> Fields()
   // Two bars along z, one on each side of the line x = y = 16, sharing only that line: where
   // 4 ranks meet.
   fields.push_back(IndexField("edge", VTK_SHORT,
-    [](int i, int j, int k) {
+    [](int i, int j, int k)
+    {
       const int x = i - 16, y = j - 16;
       const bool bar1 = x >= 0 && y >= 0 && x <= 4 && y <= 4;
       const bool bar2 = x <= 0 && y <= 0 && x >= -4 && y >= -4;
@@ -106,16 +111,18 @@ std::vector<Field> Fields()
     0.0, { { { 19.0, 19.0, 10.0 } } }));
 
   // The CT phantom (int16 HU, spacing and origin): skull, mandible and vertebrae.
-  fields.push_back(Field{ "phantom", 400.0, { { { 0, 0, 105 } }, { { 0, 65, -75 }, { 0, -20, -96 } } },
-    [](const int extent[6]) {
-      vtkNew<vtkRGPhantomSource> phantom;
-      phantom->SetDimensions(N, N, N);
-      phantom->UpdateExtent(const_cast<int*>(extent));
-      auto image = vtkSmartPointer<vtkImageData>::New();
-      image->DeepCopy(phantom->GetOutput());
-      image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
-      return image;
-    } });
+  fields.push_back(
+    Field{ "phantom", 400.0, { { { 0, 0, 105 } }, { { 0, 65, -75 }, { 0, -20, -96 } } },
+      [](const int extent[6])
+      {
+        vtkNew<vtkRGPhantomSource> phantom;
+        phantom->SetDimensions(N, N, N);
+        phantom->UpdateExtent(const_cast<int*>(extent));
+        auto image = vtkSmartPointer<vtkImageData>::New();
+        image->DeepCopy(phantom->GetOutput());
+        image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
+        return image;
+      } });
   return fields;
 }
 
@@ -192,19 +199,25 @@ void CompareUnion(vtkMultiProcessController* controller, vtkPolyData* piece,
     {
       united.Add(vtkPolyData::SafeDownCast(pieces[r]), static_cast<int>(r));
     }
-    const bool same = united.Triangles == reference->Triangles && united.Vertices == reference->Vertices;
-    RGMC_CHECK(same, what << ": the union differs from 1 rank: " << united.Triangles.size()
-                          << " vs " << reference->Triangles.size() << " triangles, "
-                          << united.Vertices.size() << " vs " << reference->Vertices.size() << " vertices");
-    RGMC_CHECK(united.DuplicatedTriangles == 0, what << ": " << united.DuplicatedTriangles << " triangles on two ranks");
-    RGMC_CHECK(united.InconsistentVertices == 0, what << ": " << united.InconsistentVertices << " vertices differ between ranks");
+    const bool same =
+      united.Triangles == reference->Triangles && united.Vertices == reference->Vertices;
+    RGMC_CHECK(same,
+      what << ": the union differs from 1 rank: " << united.Triangles.size() << " vs "
+           << reference->Triangles.size() << " triangles, " << united.Vertices.size() << " vs "
+           << reference->Vertices.size() << " vertices");
+    RGMC_CHECK(united.DuplicatedTriangles == 0,
+      what << ": " << united.DuplicatedTriangles << " triangles on two ranks");
+    RGMC_CHECK(united.InconsistentVertices == 0,
+      what << ": " << united.InconsistentVertices << " vertices differ between ranks");
     RGMC_CHECK(united.WrongRankIds == 0, what << ": RankId is not the rank that made the triangle");
-    failed = !same || united.DuplicatedTriangles || united.InconsistentVertices || united.WrongRankIds;
+    failed =
+      !same || united.DuplicatedTriangles || united.InconsistentVertices || united.WrongRankIds;
   }
   // Every rank reports the same global counts.
   vtkFieldData* fd = piece->GetFieldData();
-  long long triangles = fd->GetArray("NumberOfTriangles") ?
-    vtkIdTypeArray::SafeDownCast(fd->GetArray("NumberOfTriangles"))->GetValue(0) : -1;
+  long long triangles = fd->GetArray("NumberOfTriangles")
+    ? vtkIdTypeArray::SafeDownCast(fd->GetArray("NumberOfTriangles"))->GetValue(0)
+    : -1;
   long long lo = 0, hi = 0;
   controller->AllReduce(&triangles, &lo, 1, vtkCommunicator::MIN_OP);
   controller->AllReduce(&triangles, &hi, 1, vtkCommunicator::MAX_OP);
@@ -235,12 +248,14 @@ void CollectiveErrors(vtkMultiProcessController* controller)
   const Field field = Fields()[0];
   const Piece piece = PieceOf("block", Whole, rank, ranks);
   const Seeds seed = field.SeedSets[0];
-  auto expect = [&](const std::string& what, const Run& r, const std::string& text, bool error) {
+  auto expect = [&](const std::string& what, const Run& r, const std::string& text, bool error)
+  {
     const std::string message = Text(error ? r.Errors : r.Warnings);
     RGMC_CHECK(message.find(text) != std::string::npos,
       what << " (rank " << rank << "): expected '" << text << "', got [" << r.Errors << "]["
            << r.Warnings << "]");
-    RGMC_CHECK(r.Output->GetNumberOfCells() == 0, what << " (rank " << rank << "): output not empty");
+    RGMC_CHECK(
+      r.Output->GetNumberOfCells() == 0, what << " (rank " << rank << "): output not empty");
     RGMC_CHECK(SameOnAllRanks(controller, message), what << ": the ranks' messages differ");
   };
 
@@ -256,8 +271,9 @@ void CollectiveErrors(vtkMultiProcessController* controller)
       vectors->Fill(0.5);
       image->GetPointData()->SetScalars(vectors);
     }
-    expect("bad array on the last rank", Extract(controller, image, field.Isovalue,
-      vtkRGMarchingCubes::ALL_COMPONENTS, {}), "has 3 components", true);
+    expect("bad array on the last rank",
+      Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::ALL_COMPONENTS, {}),
+      "has 3 components", true);
   }
   // NaN samples on the last rank's piece, where the surface passes.
   {
@@ -270,30 +286,33 @@ void CollectiveErrors(vtkMultiProcessController* controller)
         f->SetComponent(n, 0, std::numeric_limits<double>::quiet_NaN());
       }
     }
-    expect("NaN on the last rank", Extract(controller, image, field.Isovalue,
-      vtkRGMarchingCubes::ALL_COMPONENTS, {}), "is NaN", true);
+    expect("NaN on the last rank",
+      Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::ALL_COMPONENTS, {}), "is NaN",
+      true);
   }
   // A seed outside the volume.
   {
     vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
-    expect("seed outside", Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::SEEDED,
-      { { 16, 16, 90 } }), "lies outside the volume", false);
+    expect("seed outside",
+      Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::SEEDED, { { 16, 16, 90 } }),
+      "lies outside the volume", false);
   }
   // An abort on the last rank only: every rank stops with an empty output.
   {
     vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
     vtkNew<vtkCallbackCommand> abort;
-    abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
-      static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
-    });
+    abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*)
+      { static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1); });
     const Run r = Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::ALL_COMPONENTS, {},
-      [&](vtkRGMarchingCubes* rg) {
+      [&](vtkRGMarchingCubes* rg)
+      {
         if (rank == ranks - 1)
         {
           rg->AddObserver(vtkCommand::ProgressEvent, abort);
         }
       });
-    RGMC_CHECK(r.Output->GetNumberOfCells() == 0, "abort on the last rank (rank " << rank << "): output not empty");
+    RGMC_CHECK(r.Output->GetNumberOfCells() == 0,
+      "abort on the last rank (rank " << rank << "): output not empty");
   }
 }
 
@@ -301,18 +320,7 @@ void CollectiveErrors(vtkMultiProcessController* controller)
 
 int main(int argc, char* argv[])
 {
-  const bool dummy = argc > 1 && std::string(argv[1]) == "--dummy";
-  vtkSmartPointer<vtkMultiProcessController> controller;
-  if (dummy)
-  {
-    controller = vtkSmartPointer<vtkDummyController>::New();
-  }
-  else
-  {
-    controller = vtkSmartPointer<vtkMPIController>::New();
-  }
-  controller->Initialize(&argc, &argv);
-  vtkMultiProcessController::SetGlobalController(controller);
+  vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
   vtkNew<vtkDummyController> single;
 
@@ -336,7 +344,8 @@ int main(int argc, char* argv[])
           Run r = Extract(single, whole, field.Isovalue, mode,
             mode == vtkRGMarchingCubes::SEEDED ? field.SeedSets[s] : Seeds());
           RGMC_CHECK(r.Output->GetNumberOfCells() > 0 && r.Errors.empty() && r.Warnings.empty(),
-            field.Name << " " << modeNames[mode] << ": the reference is empty: " << r.Errors << r.Warnings);
+            field.Name << " " << modeNames[mode] << ": the reference is empty: " << r.Errors
+                       << r.Warnings);
           references.emplace_back();
           references.back().Add(r.Output, 0);
         }
@@ -344,7 +353,8 @@ int main(int argc, char* argv[])
     }
     for (const std::string& how : Decompositions(ranks))
     {
-      vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, PieceOf(how, Whole, rank, ranks));
+      vtkSmartPointer<vtkImageData> image =
+        MakePiece(field.Make, Whole, PieceOf(how, Whole, rank, ranks));
       std::size_t next = 0;
       for (int mode : modes)
       {
@@ -370,7 +380,8 @@ int main(int argc, char* argv[])
           }
           else
           {
-            RGMC_CHECK(r.Errors.empty() && r.Warnings.empty(), what.str() << ": " << r.Errors << r.Warnings);
+            RGMC_CHECK(
+              r.Errors.empty() && r.Warnings.empty(), what.str() << ": " << r.Errors << r.Warnings);
           }
           CompareUnion(controller, r.Output, rank == 0 ? &references[next] : nullptr, what.str());
           ++runs;
@@ -387,8 +398,8 @@ int main(int argc, char* argv[])
   controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
   if (rank == 0)
   {
-    std::cout << "TestDistributed on " << ranks << " ranks: " << runs << " runs compared, "
-              << total << " failed checks\n";
+    std::cout << "TestDistributed on " << ranks << " ranks: " << runs << " runs compared, " << total
+              << " failed checks\n";
   }
   controller->Finalize();
   return total == 0 ? 0 : 1;

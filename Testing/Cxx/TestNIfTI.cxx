@@ -6,10 +6,10 @@
 // VTK's (RAS, converted to our LPS); the union equals the 1-rank volume. Bad files give the
 // same message, naming the file, on every rank.
 #include "rgmcReaderTestData.h"
+#include "rgmcTestController.h"
 
 #include "vtkDummyController.h"
 #include "vtkExtentTranslator.h"
-#include "vtkMPIController.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNIFTIImageReader.h"
@@ -270,18 +270,7 @@ void BadFiles(vtkMultiProcessController* controller, const std::string& dir)
 
 int main(int argc, char* argv[])
 {
-  const bool dummy = argc > 1 && std::string(argv[1]) == "--dummy";
-  vtkSmartPointer<vtkMultiProcessController> controller;
-  if (dummy)
-  {
-    controller = vtkSmartPointer<vtkDummyController>::New();
-  }
-  else
-  {
-    controller = vtkSmartPointer<vtkMPIController>::New();
-  }
-  controller->Initialize(&argc, &argv);
-  vtkMultiProcessController::SetGlobalController(controller);
+  vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
   const std::string dir =
     ScratchDirectory(controller, "TestNIfTI-" + std::to_string(ranks) + "ranks");

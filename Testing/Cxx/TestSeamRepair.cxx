@@ -7,6 +7,7 @@
 // coordinates fallback, and vtkFlyingEdges3D pieces) must close too. The merged writer's mesh
 // has no duplicate vertex. Bad input gives the same error on every rank.
 #include "rgmcDistributedData.h"
+#include "rgmcTestController.h"
 #include "rgmcTestData.h"
 
 #include "vtkCallbackCommand.h"
@@ -16,7 +17,6 @@
 #include "vtkFieldData.h"
 #include "vtkFlyingEdges3D.h"
 #include "vtkIdTypeArray.h"
-#include "vtkMPIController.h"
 #include "vtkRGMergedSurfaceWriter.h"
 #include "vtkRGPhantomSource.h"
 #include "vtkRGSeamRepair.h"
@@ -51,30 +51,39 @@ std::vector<Surface> Surfaces()
   const double centres[5][3] = { { 32, 32, 32 }, { 32, 12, 12 }, { 12, 32, 50 }, { 50, 50, 32 },
     { 12, 12, 12 } };
   surfaces.push_back(Surface{ "five spheres",
-    [centres](const int extent[6]) {
-      return MakeImage(extent, VTK_DOUBLE, [centres](int i, int j, int k) {
-        double f = -1e9;
-        for (const auto& c : centres)
+    [centres](const int extent[6])
+    {
+      return MakeImage(extent, VTK_DOUBLE,
+        [centres](int i, int j, int k)
         {
-          f = std::max(f, 7.3 - std::sqrt((i - c[0]) * (i - c[0]) + (j - c[1]) * (j - c[1]) +
-                                 (k - c[2]) * (k - c[2])));
-        }
-        return f;
-      });
+          double f = -1e9;
+          for (const auto& c : centres)
+          {
+            f = std::max(f,
+              7.3 -
+                std::sqrt(
+                  (i - c[0]) * (i - c[0]) + (j - c[1]) * (j - c[1]) + (k - c[2]) * (k - c[2])));
+          }
+          return f;
+        });
     },
     0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}, 10 });
   // A torus around the corner where 8 ranks meet.
   surfaces.push_back(Surface{ "torus",
-    [](const int extent[6]) {
-      return MakeImage(extent, VTK_FLOAT, [](int i, int j, int k) {
-        const double rho = std::sqrt((i - 32.0) * (i - 32.0) + (j - 32.3) * (j - 32.3));
-        return 5.2 - std::sqrt((rho - 14.0) * (rho - 14.0) + (k - 32.4) * (k - 32.4));
-      });
+    [](const int extent[6])
+    {
+      return MakeImage(extent, VTK_FLOAT,
+        [](int i, int j, int k)
+        {
+          const double rho = std::sqrt((i - 32.0) * (i - 32.0) + (j - 32.3) * (j - 32.3));
+          return 5.2 - std::sqrt((rho - 14.0) * (rho - 14.0) + (k - 32.4) * (k - 32.4));
+        });
     },
     0.0, vtkRGMarchingCubes::SEEDED, { { 46.0, 32.0, 32.0 } }, 0 });
   // The phantom's skull: a shell with 5 holes (Euler characteristic 4 - 2 * 5).
   surfaces.push_back(Surface{ "skull",
-    [](const int extent[6]) {
+    [](const int extent[6])
+    {
       vtkNew<vtkRGPhantomSource> phantom;
       phantom->SetDimensions(65, 65, 65);
       phantom->UpdateExtent(const_cast<int*>(extent));
@@ -171,11 +180,11 @@ void Compare(vtkMultiProcessController* controller, vtkPolyData* piece, const Me
   long long referenceEuler, const std::string& what)
 {
   const long long closed = Field(piece, "Closed"), euler = Field(piece, "EulerCharacteristic");
-  RGMC_CHECK(closed == 1, what << ": not closed (" << Field(piece, "BoundaryEdges")
-                               << " boundary, " << Field(piece, "NonManifoldEdges")
-                               << " non-manifold edges)");
-  RGMC_CHECK(euler == referenceEuler, what << ": Euler characteristic " << euler << ", expected "
-                                           << referenceEuler);
+  RGMC_CHECK(closed == 1,
+    what << ": not closed (" << Field(piece, "BoundaryEdges") << " boundary, "
+         << Field(piece, "NonManifoldEdges") << " non-manifold edges)");
+  RGMC_CHECK(euler == referenceEuler,
+    what << ": Euler characteristic " << euler << ", expected " << referenceEuler);
   std::vector<vtkSmartPointer<vtkDataObject>> pieces;
   controller->Gather(piece, pieces, 0);
   if (controller->GetLocalProcessId() != 0)
@@ -217,7 +226,8 @@ void Compare(vtkMultiProcessController* controller, vtkPolyData* piece, const Me
 void CompareWithVTK(vtkMultiProcessController* single, vtkPolyData* extracted, double spacing,
   const std::string& name)
 {
-  vtkSmartPointer<vtkPolyData> merged = Repair(single, extracted, vtkRGSeamRepair::NO_SMOOTHING).Output;
+  vtkSmartPointer<vtkPolyData> merged =
+    Repair(single, extracted, vtkRGSeamRepair::NO_SMOOTHING).Output;
   vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(merged->GetPointData()->GetGlobalIds());
   for (vtkIdType p = 0; p < merged->GetNumberOfPoints(); ++p)
   {
@@ -229,7 +239,8 @@ void CompareWithVTK(vtkMultiProcessController* single, vtkPolyData* extracted, d
   vtkNew<vtkWindowedSincPolyDataFilter> vtk;
   vtk->SetInputData(mesh);
   vtk->Update();
-  vtkSmartPointer<vtkPolyData> ours = Repair(single, extracted, vtkRGSeamRepair::WINDOWED_SINC).Output;
+  vtkSmartPointer<vtkPolyData> ours =
+    Repair(single, extracted, vtkRGSeamRepair::WINDOWED_SINC).Output;
   double worst = 0;
   long long bitwise = 0;
   for (vtkIdType p = 0; p < ours->GetNumberOfPoints(); ++p)
@@ -243,14 +254,15 @@ void CompareWithVTK(vtkMultiProcessController* single, vtkPolyData* extracted, d
   std::cout << name << ": windowed sinc vs vtkWindowedSincPolyDataFilter: max distance "
             << worst / spacing << " spacings; " << bitwise << " of " << ours->GetNumberOfPoints()
             << " points identical to the bit\n";
-  RGMC_CHECK(worst <= 1e-5 * spacing, name << ": windowed sinc is " << worst / spacing
-                                           << " spacings from VTK's");
+  RGMC_CHECK(worst <= 1e-5 * spacing,
+    name << ": windowed sinc is " << worst / spacing << " spacings from VTK's");
 }
 
 void BadInput(vtkMultiProcessController* controller)
 {
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
-  auto expect = [&](const std::string& what, vtkPolyData* input, const std::string& text) {
+  auto expect = [&](const std::string& what, vtkPolyData* input, const std::string& text)
+  {
     const Repaired r = Repair(controller, input, vtkRGSeamRepair::LAPLACIAN);
     const std::size_t at = r.Errors.find("): ");
     const std::string message = at == std::string::npos ? r.Errors : r.Errors.substr(at + 3);
@@ -263,7 +275,8 @@ void BadInput(vtkMultiProcessController* controller)
     RGMC_CHECK(lo == hi, what << ": the ranks' messages differ");
     std::cout << (rank == 0 ? what + ": " + message : std::string());
   };
-  auto triangle = [](vtkPolyData* pd) {
+  auto triangle = [](vtkPolyData* pd)
+  {
     vtkNew<vtkPoints> pts;
     pts->InsertNextPoint(0, 0, 0);
     pts->InsertNextPoint(1, 0, 0);
@@ -328,13 +341,15 @@ void Abort(vtkMultiProcessController* controller)
   repair->SetInputData(extracted);
   repair->SetNumberOfIterations(200);
   vtkNew<vtkCallbackCommand> abort;
-  abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
-    vtkAlgorithm* algorithm = static_cast<vtkAlgorithm*>(caller);
-    if (algorithm->GetProgress() > 0.5)
+  abort->SetCallback(
+    [](vtkObject* caller, unsigned long, void*, void*)
     {
-      algorithm->SetAbortExecute(1);
-    }
-  });
+      vtkAlgorithm* algorithm = static_cast<vtkAlgorithm*>(caller);
+      if (algorithm->GetProgress() > 0.5)
+      {
+        algorithm->SetAbortExecute(1);
+      }
+    });
   if (rank == ranks - 1)
   {
     repair->AddObserver(vtkCommand::ProgressEvent, abort);
@@ -363,18 +378,7 @@ void Abort(vtkMultiProcessController* controller)
 
 int main(int argc, char* argv[])
 {
-  const bool dummy = argc > 1 && std::string(argv[1]) == "--dummy";
-  vtkSmartPointer<vtkMultiProcessController> controller;
-  if (dummy)
-  {
-    controller = vtkSmartPointer<vtkDummyController>::New();
-  }
-  else
-  {
-    controller = vtkSmartPointer<vtkMPIController>::New();
-  }
-  controller->Initialize(&argc, &argv);
-  vtkMultiProcessController::SetGlobalController(controller);
+  vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
   vtkNew<vtkDummyController> single;
 
@@ -400,7 +404,8 @@ int main(int argc, char* argv[])
           RGMC_CHECK(r.Errors.empty(), surface.Name << ": " << r.Errors);
           RGMC_CHECK(Field(r.Output, "Closed") == 1, surface.Name << " on 1 rank is not closed");
           RGMC_CHECK(Field(r.Output, "EulerCharacteristic") == surface.Euler,
-            surface.Name << " on 1 rank: Euler characteristic " << Field(r.Output, "EulerCharacteristic"));
+            surface.Name << " on 1 rank: Euler characteristic "
+                         << Field(r.Output, "EulerCharacteristic"));
           references[2 * method + keyed].Add(r.Output);
         }
       }
@@ -454,8 +459,9 @@ int main(int argc, char* argv[])
       const long long nonManifold = Field(r.Output, "NonManifoldEdges");
       // vtkFlyingEdges3D keeps every component and zero-area triangles; what matters here is
       // that the seams close: no boundary edge.
-      RGMC_CHECK(boundary == 0, surface.Name << ", vtkFlyingEdges3D pieces on " << ranks
-                                             << " ranks: " << boundary << " boundary edges");
+      RGMC_CHECK(boundary == 0,
+        surface.Name << ", vtkFlyingEdges3D pieces on " << ranks << " ranks: " << boundary
+                     << " boundary edges");
       if (rank == 0)
       {
         std::cout << surface.Name << ", vtkFlyingEdges3D pieces: " << boundary << " boundary, "
