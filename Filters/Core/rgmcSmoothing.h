@@ -130,8 +130,8 @@ struct Stencils
 /// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T (the
 /// mesh's point type: each step is stored in it, as VTK's filters do).
 template <typename T>
-void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& points,
-  const T* cur, T* next, double relaxation)
+void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* cur,
+  T* next, double relaxation)
 {
   for (std::size_t r = 0; r < points.size(); ++r)
   {
@@ -155,26 +155,35 @@ void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& po
 // do (they subtract two tuple values of the points' type), so that float meshes give VTK's
 // result to the bit.
 
+/// sum((x[v] - x[w]) / n) over the n neighbours w of vertex v (stencil row r), each difference
+/// rounded to T first, as VTK's windowed sinc does.
+template <typename T>
+void SincDelta(const Stencils& stencils, std::size_t r, std::int64_t v, const T* x, double delta[3])
+{
+  const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
+  const double n = static_cast<double>(end - begin);
+  delta[0] = delta[1] = delta[2] = 0;
+  for (std::int64_t s = begin; s < end; ++s)
+  {
+    const std::int64_t w = stencils.Neighbours[s];
+    for (int k = 0; k < 3; ++k)
+    {
+      delta[k] += static_cast<double>(static_cast<T>(x[3 * v + k] - x[3 * w + k])) / n;
+    }
+  }
+}
+
 /// The first windowed-sinc step (Taubin): x1 = x0 - 0.5 * sum((x0 - y0) / n),
 /// x3 = c0 x0 + c1 x1 (x1 before it is stored).
 template <typename T>
-void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& points,
-  const T* x0, T* x1, T* x3, const double* c)
+void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* x0,
+  T* x1, T* x3, const double* c)
 {
   for (std::size_t r = 0; r < points.size(); ++r)
   {
     const std::int64_t v = points[r];
-    const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
-    const double n = static_cast<double>(end - begin);
-    double delta[3] = { 0, 0, 0 };
-    for (std::int64_t s = begin; s < end; ++s)
-    {
-      const std::int64_t w = stencils.Neighbours[s];
-      for (int k = 0; k < 3; ++k)
-      {
-        delta[k] += static_cast<double>(static_cast<T>(x0[3 * v + k] - x0[3 * w + k])) / n;
-      }
-    }
+    double delta[3];
+    SincDelta(stencils, r, v, x0, delta);
     for (int k = 0; k < 3; ++k)
     {
       const double x = static_cast<double>(x0[3 * v + k]);
@@ -194,21 +203,13 @@ void SincStep(const Stencils& stencils, const std::vector<std::int64_t>& points,
   for (std::size_t r = 0; r < points.size(); ++r)
   {
     const std::int64_t v = points[r];
-    const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
-    const double n = static_cast<double>(end - begin);
-    double delta[3] = { 0, 0, 0 };
-    for (std::int64_t s = begin; s < end; ++s)
-    {
-      const std::int64_t w = stencils.Neighbours[s];
-      for (int k = 0; k < 3; ++k)
-      {
-        delta[k] += static_cast<double>(static_cast<T>(x1[3 * v + k] - x1[3 * w + k])) / n;
-      }
-    }
+    double delta[3];
+    SincDelta(stencils, r, v, x1, delta);
     for (int k = 0; k < 3; ++k)
     {
       const T a = x1[3 * v + k];
-      const double step = static_cast<double>(static_cast<T>(static_cast<T>(a - x0[3 * v + k]) + a)) - delta[k];
+      const double step =
+        static_cast<double>(static_cast<T>(static_cast<T>(a - x0[3 * v + k]) + a)) - delta[k];
       x2[3 * v + k] = static_cast<T>(step);
       x3[3 * v + k] = static_cast<T>(static_cast<double>(x3[3 * v + k]) + c * step);
     }
