@@ -129,8 +129,15 @@ def targets(rows, args):
     one, two = find(rows, "phantom512", 1, "seeded"), find(rows, "phantom512", 2, "seeded")
     add("512^3 phantom, seeded speedup at 2 ranks (at least 1.7)",
         one["min_seconds"] / two["min_seconds"] if one and two else None, 1.7, False)
+    add("512^3 phantom, seeded / vtkFlyingEdges3D at 2 ranks (at most 0.5)",
+        ratio("phantom512", 2, "seeded", "fe"), 0.5, True)
     add("sparse sphere (512^3), seeded / vtkFlyingEdges3D at 1 rank (at most 0.05)",
         ratio("sphere512", 1, "seeded", "fe"), 0.05, True)
+    add("sparse sphere (512^3), seeded / vtkFlyingEdges3D at 2 ranks (at most 0.05)",
+        ratio("sphere512", 2, "seeded", "fe"), 0.05, True)
+    for ranks in (1, 2):
+        add("512^3 phantom's skull, seam repair + 20 Laplacian / ParaView Smooth at %d rank%s (at most 1.5)"
+            % (ranks, "s" if ranks > 1 else ""), ratio("phantom512", ranks, "repair", "smooth"), 1.5, True)
     sweep = sorted((r for r in rows if r.get("case", "").startswith("sphere-sweep-") and r.get("method") == "seeded"),
                    key=lambda r: r["dims"][0])
     growth = sweep[-1]["min_seconds"] / sweep[0]["min_seconds"] - 1 if len(sweep) > 1 else None
@@ -201,7 +208,7 @@ def report(rows, args, pictures):
                  args.sweep_repeats,
                  "`*`: more ranks than cores (oversubscribed): those times measure correctness "
                  "under load, not speed." if max(args.ranks) > cores else ""),
-             "", "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+             "", "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + [a for a in sys.argv[1:] if a != "--report-only"]), "",
              "## Targets", "", "| target | measured | |", "|---|---|---|"] + targets(rows, args) + [""]
     for case in args.cases:
         if not find(rows, case, 1, "seeded"):
@@ -235,6 +242,16 @@ def report(rows, args, pictures):
                                     first["min_seconds"] / many["min_seconds"], 100 * share, 1 / share))
         if speedups:
             lines += ["Seeded speedup (Table 2 of the paper): " + "; ".join(speedups) + ".", ""]
+        ratios = []
+        for ranks in args.ranks:
+            mine, fe, contour = (find(rows, case, ranks, m) for m in ("seeded", "fe", "contour"))
+            if mine and fe and contour:
+                ratios.append("| %d rank%s%s | %.3f | %.3f |" % (
+                    ranks, "s" if ranks > 1 else "", "*" if ranks > cores else "",
+                    mine["min_seconds"] / fe["min_seconds"], mine["min_seconds"] / contour["min_seconds"]))
+        if ratios:
+            lines += ["Seeded time over the full-scan methods' at the same rank count:", "",
+                      "| | / vtkFlyingEdges3D | / ParaView Contour |", "|---|---|---|"] + ratios + [""]
         fe, cc = find(rows, case, 1, "fe"), find(rows, case, 1, "contour+connectivity")
         if fe and cc:
             lines += ["At 1 rank the seeded mode takes %.3fx the time of vtkFlyingEdges3D and %.3fx that "
@@ -287,16 +304,26 @@ def main(argv):
     parser.add_argument("--binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcEvaluation"))
     parser.add_argument("--output", default=os.path.join(rgmc_common.ROOT, "build", "evaluation"),
                         help="folder for report.md, results.json and the plots")
+    parser.add_argument("--report-only", action="store_true",
+                        help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)
     args.cases = [c for c in args.cases.split(",") if c]
     args.ranks = sorted(int(r) for r in args.ranks.split(","))
     args.sweep = [int(n) for n in args.sweep.split(",") if n]
-    if not os.path.isfile(args.binary):
+    if not args.report_only and not os.path.isfile(args.binary):
         raise rgmc_common.UsageError("no evaluation program at %s: build first (./rgmc build)" % args.binary)
-    rows = run(args)
-    os.makedirs(args.output, exist_ok=True)
-    with open(os.path.join(args.output, "results.json"), "w") as out:
-        json.dump(rows, out, indent=1)
+    results = os.path.join(args.output, "results.json")
+    if args.report_only:
+        # The report and plots again from the last run's results (the same options as that run).
+        if not os.path.isfile(results):
+            raise rgmc_common.UsageError("no %s: run the evaluation first" % results)
+        with open(results) as source:
+            rows = json.load(source)
+    else:
+        rows = run(args)
+        os.makedirs(args.output, exist_ok=True)
+        with open(results, "w") as out:
+            json.dump(rows, out, indent=1)
     pictures = plots(rows, args, args.output)
     text = report(rows, args, pictures)
     with open(os.path.join(args.output, "report.md"), "w") as out:
