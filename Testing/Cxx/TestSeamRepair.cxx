@@ -331,7 +331,7 @@ void BadInput(vtkMultiProcessController* controller)
 void Abort(vtkMultiProcessController* controller)
 {
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
-  const Surface& surface = Surfaces().front();
+  const Surface surface = Surfaces().front();
   vtkSmartPointer<vtkImageData> image =
     MakePiece(surface.Make, Whole, PieceOf("block", Whole, rank, ranks));
   vtkSmartPointer<vtkPolyData> extracted =
