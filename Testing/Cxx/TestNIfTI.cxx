@@ -104,19 +104,6 @@ void WriteGz(const std::string& path, const std::vector<char>& bytes)
   gzclose(out);
 }
 
-std::vector<char> Gunzip(const std::string& path)
-{
-  std::vector<char> bytes;
-  gzFile in = gzopen(path.c_str(), "rb");
-  char chunk[1 << 16];
-  for (int got; (got = gzread(in, chunk, sizeof(chunk))) > 0;)
-  {
-    bytes.insert(bytes.end(), chunk, chunk + got);
-  }
-  gzclose(in);
-  return bytes;
-}
-
 vtkSmartPointer<vtkRGNIfTIReader> Reader(vtkMultiProcessController* c, const std::string& path)
 {
   auto reader = vtkSmartPointer<vtkRGNIfTIReader>::New();

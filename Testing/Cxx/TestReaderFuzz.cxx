@@ -115,19 +115,6 @@ std::vector<char> Gzip(const std::vector<char>& bytes)
   return out;
 }
 
-std::vector<char> Gunzip(const std::string& path)
-{
-  std::vector<char> bytes;
-  gzFile in = gzopen(path.c_str(), "rb");
-  char chunk[1 << 16];
-  for (int got; (got = gzread(in, chunk, sizeof(chunk))) > 0;)
-  {
-    bytes.insert(bytes.end(), chunk, chunk + got);
-  }
-  gzclose(in);
-  return bytes;
-}
-
 } // namespace
 
 int main(int argc, char* argv[])

@@ -118,6 +118,15 @@ Repaired Repair(vtkMultiProcessController* controller, vtkPolyData* input, int m
   return r;
 }
 
+/// The same surface without its vertex keys (the repair then matches points by coordinates).
+vtkSmartPointer<vtkPolyData> WithoutKeys(vtkPolyData* pd)
+{
+  auto unkeyed = vtkSmartPointer<vtkPolyData>::New();
+  unkeyed->ShallowCopy(pd);
+  unkeyed->GetPointData()->SetGlobalIds(nullptr);
+  return unkeyed;
+}
+
 long long Field(vtkPolyData* pd, const char* name)
 {
   vtkIdTypeArray* a = vtkIdTypeArray::SafeDownCast(pd->GetFieldData()->GetArray(name));
@@ -358,6 +367,10 @@ void Abort(vtkMultiProcessController* controller)
   long long cells = repair->GetOutput()->GetNumberOfCells(), total = 0;
   controller->AllReduce(&cells, &total, 1, vtkCommunicator::SUM_OP);
   RGMC_CHECK(total == 0, "an abort on the last rank left " << total << " triangles");
+  if (rank == 0 && total == 0)
+  {
+    std::cout << "abort on rank " << ranks - 1 << " during smoothing: every rank stopped\n";
+  }
 
   // The same filter, no longer aborted, repairs again.
   repair->RemoveAllObservers();
@@ -368,10 +381,6 @@ void Abort(vtkMultiProcessController* controller)
   controller->AllReduce(&cells, &total, 1, vtkCommunicator::SUM_OP);
   RGMC_CHECK(total > 0 && Field(repair->GetOutput(), "Closed") == 1,
     "after an abort, the next update gives " << total << " triangles");
-  if (rank == 0)
-  {
-    std::cout << "abort on rank " << ranks - 1 << " during smoothing: every rank stopped\n";
-  }
 }
 
 } // namespace
@@ -393,9 +402,7 @@ int main(int argc, char* argv[])
       spacing = whole->GetSpacing()[0];
       vtkSmartPointer<vtkPolyData> extracted =
         Extract(single, whole, surface.Isovalue, surface.Mode, surface.SeedPoints).Output;
-      vtkNew<vtkPolyData> unkeyed;
-      unkeyed->ShallowCopy(extracted);
-      unkeyed->GetPointData()->SetGlobalIds(nullptr);
+      vtkSmartPointer<vtkPolyData> unkeyed = WithoutKeys(extracted);
       for (int method = 0; method < 3; ++method)
       {
         for (int keyed = 0; keyed < 2; ++keyed)
@@ -418,9 +425,7 @@ int main(int argc, char* argv[])
         MakePiece(surface.Make, Whole, PieceOf(how, Whole, rank, ranks));
       vtkSmartPointer<vtkPolyData> extracted =
         Extract(controller, image, surface.Isovalue, surface.Mode, surface.SeedPoints).Output;
-      vtkNew<vtkPolyData> unkeyed;
-      unkeyed->ShallowCopy(extracted);
-      unkeyed->GetPointData()->SetGlobalIds(nullptr);
+      vtkSmartPointer<vtkPolyData> unkeyed = WithoutKeys(extracted);
       for (int method = 0; method < 3; ++method)
       {
         for (int keyed = 0; keyed < 2; ++keyed)

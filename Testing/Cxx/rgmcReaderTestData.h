@@ -1,6 +1,6 @@
-// Shared by the reader tests: scratch directories, the DICOM generator run as a user runs it,
-// reading a piece through the pipeline as ParaView asks for it, and checks that a message is
-// the same on every rank.
+// Shared by the reader tests: gzip input, scratch directories, the DICOM generator run as a user
+// runs it, reading a piece through the pipeline as ParaView asks for it, and checks that a
+// message is the same on every rank.
 #ifndef rgmcReaderTestData_h
 #define rgmcReaderTestData_h
 
@@ -14,6 +14,8 @@
 #include "vtkRGPhantomSource.h"
 #include "vtkShortArray.h"
 
+#include <zlib.h>
+
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -21,11 +23,26 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace rgmc_test
 {
 
 namespace fs = std::filesystem;
+
+/// The bytes of a gzip file (what zlib could decompress of it).
+inline std::vector<char> Gunzip(const std::string& path)
+{
+  std::vector<char> bytes;
+  gzFile in = gzopen(path.c_str(), "rb");
+  char chunk[1 << 16];
+  for (int got; (got = gzread(in, chunk, sizeof(chunk))) > 0;)
+  {
+    bytes.insert(bytes.end(), chunk, chunk + got);
+  }
+  gzclose(in);
+  return bytes;
+}
 
 /// A fresh, empty directory `name` under the current directory (rank 0 makes it).
 inline std::string ScratchDirectory(vtkMultiProcessController* controller, const std::string& name)

@@ -21,6 +21,7 @@ import sys
 import time
 
 import SummaryCompare
+import rgmc_testing
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -62,12 +63,8 @@ def pvserver(args, ranks, log_path):
         log.close()
 
 
-def run(command, timeout=600):
-    print("+ " + " ".join(command), flush=True)
-    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
-    print(result.stdout[-3000:])
-    print(result.stderr[-3000:], file=sys.stderr)
-    return result
+def run(command):
+    return rgmc_testing.run(command, tail=3000)
 
 
 def main():

@@ -10,24 +10,10 @@ import json
 import os
 import re
 import struct
-import subprocess
 import sys
 
-failures = []
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-        print("FAILED: %s" % what, file=sys.stderr)
-
-
-def run(command, timeout=600):
-    print("+ " + " ".join(command), flush=True)
-    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
-    print(result.stdout)
-    print(result.stderr, file=sys.stderr)
-    return result
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rgmc_testing import check, failures, run  # noqa: E402
 
 
 def stl_triangles(path):

@@ -6,6 +6,7 @@ does, and checks the numbers fetched from the server against VTK's own filters.
 
 import argparse
 import math
+import os
 import sys
 
 from paraview import servermanager, simple
@@ -13,13 +14,8 @@ from vtkmodules.vtkCommonDataModel import vtkStaticPointLocator
 from vtkmodules.vtkFiltersCore import (vtkCleanPolyData, vtkMarchingCubes,
                                        vtkPolyDataConnectivityFilter)
 
-failures = []
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-        print("FAILED: %s" % what, file=sys.stderr)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rgmc_testing import check, failures  # noqa: E402
 
 
 def marching_cubes(image, isovalue):

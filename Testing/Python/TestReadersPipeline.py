@@ -19,25 +19,10 @@ import json
 import os
 import shutil
 import struct
-import subprocess
 import sys
 
-failures = []
-
-
-def check(condition, what):
-    print(("ok: " if condition else "FAILED: ") + what, file=sys.stderr if not condition else
-          sys.stdout)
-    if not condition:
-        failures.append(what)
-
-
-def run(command, timeout=900, env=None):
-    print("+ " + " ".join(command), flush=True)
-    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env)
-    print(result.stdout)
-    print(result.stderr, file=sys.stderr)
-    return result
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rgmc_testing import check, failures, run  # noqa: E402
 
 
 def stl_bounds(path):
