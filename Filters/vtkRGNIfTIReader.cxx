@@ -223,34 +223,6 @@ std::string DataTypeName(int datatype)
   }
 }
 
-/// The stored value range of a VTK integer type.
-void IntegerRange(int vtkType, double& lo, double& hi)
-{
-  switch (vtkType)
-  {
-    case VTK_UNSIGNED_CHAR:
-      lo = 0, hi = 255;
-      break;
-    case VTK_SIGNED_CHAR:
-      lo = -128, hi = 127;
-      break;
-    case VTK_SHORT:
-      lo = -32768, hi = 32767;
-      break;
-    case VTK_UNSIGNED_SHORT:
-      lo = 0, hi = 65535;
-      break;
-    case VTK_INT:
-      lo = -2147483648.0, hi = 2147483647.0;
-      break;
-    case VTK_UNSIGNED_INT:
-      lo = 0, hi = 4294967295.0;
-      break;
-    default:
-      lo = -9.3e18, hi = 1.8e19;
-  }
-}
-
 template <typename T>
 double Value(const char* p, bool swap)
 {
@@ -419,8 +391,9 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
     intercept = std::isfinite(h.SclInter) ? h.SclInter : 0.0;
   }
   const bool integerData = vtkType != VTK_FLOAT && vtkType != VTK_DOUBLE;
-  double lo = 0, hi = 0;
-  IntegerRange(vtkType, lo, hi);
+  double range[2];
+  vtkDataArray::GetDataTypeRange(vtkType, range);
+  const double lo = range[0], hi = range[1];
   const bool integral =
     integerData && slope == std::floor(slope) && intercept == std::floor(intercept);
   const double a = slope * lo + intercept, b = slope * hi + intercept;
