@@ -430,7 +430,6 @@ public:
     // The box of the nodes' cubes: the slabs and the edge tables cover only it, so that a small
     // surface costs the same in any volume (no plane-sized tables to touch).
     CellBox& box = this->NodeBox;
-    box = CellBox();
     for (int a = 0; a < 3; ++a)
     {
       box.Lo[a] = std::numeric_limits<int>::max();
