@@ -107,7 +107,9 @@ def mpiexec_command(ranks):
     except OSError:
         version = ""
     if "Open MPI" in version or "OpenRTE" in version:
-        command.append("--oversubscribe")  # more ranks than cores is fine for testing
+        # More ranks than cores is fine for testing. Open MPI 5 removed --oversubscribe; this
+        # spelling works on 4 and 5.
+        command += ["--map-by", ":OVERSUBSCRIBE"]
     return command
 
 

@@ -37,12 +37,10 @@ def pvserver(args, ranks, log_path):
     """A pvserver on `ranks` MPI ranks on a free loopback port; yields the port. The whole
     process group is killed on the way out if it has not exited by itself."""
     port = free_port()
-    version = subprocess.run([args.mpiexec, "--version"], capture_output=True, text=True).stdout
-    oversubscribe = ["--oversubscribe"] if "Open MPI" in version or "OpenRTE" in version else []
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     env.pop("PV_PLUGIN_PATH", None)  # the server has only what the client asks it to load
     log = open(log_path, "w")
-    server = subprocess.Popen([args.mpiexec, "-n", str(ranks)] + oversubscribe +
+    server = subprocess.Popen(rgmc_testing.mpiexec_command(args.mpiexec, ranks) +
                               [args.pvserver, "--server-port=%d" % port], stdout=log,
                               stderr=subprocess.STDOUT, env=env, start_new_session=True)
     try:

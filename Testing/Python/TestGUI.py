@@ -80,7 +80,7 @@ def render_view_box(rgb):
 def start_xvfb(width, height):
     read, write = os.pipe()
     xvfb = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "%dx%dx24" % (width, height),
-                             "-nolisten", "tcp"], pass_fds=[write], stdout=subprocess.DEVNULL,
+                             "-nolisten", "tcp", "-noreset"], pass_fds=[write], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     os.close(write)
     with os.fdopen(read) as pipe:

@@ -13,7 +13,7 @@ import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rgmc_testing import check, failures, run  # noqa: E402
+from rgmc_testing import check, failures, run, xvfb_run  # noqa: E402
 
 
 def stl_triangles(path):
@@ -58,7 +58,7 @@ def main():
     prefix = os.path.join(args.workdir, "skull")
     command = pipeline + ["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--output", prefix]
     if args.xvfb_run:
-        command = [args.xvfb_run, "-a"] + command + ["--screenshot", prefix + ".png"]
+        command = xvfb_run(args.xvfb_run, command + ["--screenshot", prefix + ".png"])
     result = run(command)
     check(result.returncode == 0, "the pipeline succeeds")
     for expected in ("input:", "72 x 72 x 72", "isovalue:   400", "seed:       (0, 0, 105)",

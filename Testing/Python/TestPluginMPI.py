@@ -12,6 +12,7 @@ import subprocess
 import sys
 
 import SummaryCompare
+import rgmc_testing
 
 
 def main():
@@ -23,15 +24,14 @@ def main():
     os.makedirs(args.workdir, exist_ok=True)
     script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "PluginSummary.py")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    version = subprocess.run([args.mpiexec, "--version"], capture_output=True, text=True).stdout
-    oversubscribe = ["--oversubscribe"] if "Open MPI" in version or "OpenRTE" in version else []
 
     summaries = {}
     for ranks in [1] + [int(r) for r in args.ranks.split(",")]:
         output = os.path.join(args.workdir, "summary-%d.json" % ranks)
         command = [args.pvbatch, script, "--plugin", args.plugin, "--output", output]
         if ranks > 1:
-            command = [args.mpiexec, "-n", str(ranks)] + oversubscribe + [args.pvbatch, "--mpi"] + command[1:]
+            command = (rgmc_testing.mpiexec_command(args.mpiexec, ranks) + [args.pvbatch, "--mpi"] +
+                       command[1:])
         print("+ " + " ".join(command), flush=True)
         result = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
         print(result.stdout)

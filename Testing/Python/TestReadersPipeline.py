@@ -22,7 +22,7 @@ import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rgmc_testing import check, failures, run  # noqa: E402
+from rgmc_testing import check, failures, mpiexec_command, run  # noqa: E402
 
 
 def stl_bounds(path):
@@ -106,7 +106,7 @@ def main():
 
     # File > Open under mpiexec: the plugin's readers, a slab per rank.
     out = os.path.join(args.workdir, "mpi.json")
-    result = run([args.mpiexec, "-n", "2", "--oversubscribe", args.pvbatch, "--mpi",
+    result = run(mpiexec_command(args.mpiexec, 2) + [args.pvbatch, "--mpi",
                   os.path.join(os.path.dirname(os.path.abspath(__file__)), "ReadersMPI.py"),
                   "--plugin", args.plugin, "--dicom", series, "--nifti",
                   os.path.join(args.mricron, "ch2.nii.gz"), "--out", out], env=env)

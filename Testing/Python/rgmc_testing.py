@@ -1,8 +1,12 @@
-"""What the Python tests share: the list of failed checks, and running a command with its output
-shown in the test's log."""
+"""What the Python tests share: the list of failed checks, running a command with its output
+shown in the test's log, and how to start MPI and a private X server on every Debian release."""
 
 import subprocess
 import sys
+
+# Xvfb resets whenever its last client disconnects; an MPI rank that connects during the reset
+# aborts with "bad X server connection". -noreset keeps the server up for the whole command.
+XVFB_SERVER_ARGS = "-screen 0 1280x1024x24 -noreset"
 
 failures = []
 
@@ -22,3 +26,16 @@ def run(command, timeout=900, env=None, tail=None):
     print(result.stdout[-tail:] if tail else result.stdout)
     print(result.stderr[-tail:] if tail else result.stderr, file=sys.stderr)
     return result
+
+
+def xvfb_run(xvfb_run_program, command):
+    """`command` under a private X server that never resets (see XVFB_SERVER_ARGS)."""
+    return [xvfb_run_program, "-a", "-s", XVFB_SERVER_ARGS] + command
+
+
+def mpiexec_command(mpiexec, ranks):
+    """`mpiexec -n ranks` with the flags Open MPI needs to run more ranks than cores. Open MPI 5
+    removed --oversubscribe; --map-by :OVERSUBSCRIBE works on 4 and 5."""
+    version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True).stdout
+    oversubscribe = ["--map-by", ":OVERSUBSCRIBE"] if "Open MPI" in version or "OpenRTE" in version else []
+    return [mpiexec, "-n", str(ranks)] + oversubscribe
