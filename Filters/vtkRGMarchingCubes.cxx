@@ -418,7 +418,8 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
     infoLengths.data(), infoOffsets.data(), 0);
   vtkIdType edgeLength = static_cast<vtkIdType>(flatEdges.size());
   std::vector<vtkIdType> edgeLengths(ranks.Size), edgeOffsets(ranks.Size + 1, 0);
-  ranks.C->Gather(&edgeLength, edgeLengths.data(), 1, 0);
+  // Every rank learns every length: VTK 9.5's GatherV reads the lengths and offsets on all ranks.
+  ranks.C->AllGather(&edgeLength, edgeLengths.data(), 1);
   for (int r = 0; r < ranks.Size; ++r)
   {
     edgeOffsets[r + 1] = edgeOffsets[r] + edgeLengths[r];
