@@ -29,7 +29,7 @@ import zlib
 import numpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-BACKGROUND = (82, 87, 110)  # ParaView 5.11's default render view background, as 8-bit RGB
+BACKGROUND = (82, 87, 110)  # the render view's background (GUIReady.py sets it), as 8-bit RGB
 
 
 def read_xwd(path):
@@ -105,7 +105,7 @@ def wait_for(path, seconds, process):
 def press_p_over_the_view(env, workdir):
     """Enlarges and focuses ParaView's window, then presses P with the mouse in the middle of
     the render view (found by its background colour)."""
-    windows = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", "ParaView 5"], env=env,
+    windows = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", "ParaView [0-9]"], env=env,
                              capture_output=True, text=True).stdout.split()
     if not windows:
         raise RuntimeError("no ParaView window on the display")
@@ -131,8 +131,9 @@ def main():
     shutil.rmtree(workdir, ignore_errors=True)
     os.makedirs(workdir)
     with open(os.path.join(HERE, "TestGUI.xml")) as template:
-        events = template.read().replace("@WORKDIR@", workdir).replace(
-            "@CHECKS@", os.path.join(HERE, "GUIChecks.py"))
+        events = template.read().replace("@WORKDIR@", workdir)
+    events = events.replace("@CHECKS@", os.path.join(HERE, "GUIChecks.py"))
+    events = events.replace("@READY@", os.path.join(HERE, "GUIReady.py"))
     script = os.path.join(workdir, "TestGUI.xml")
     with open(script, "w") as out:
         out.write(events)
