@@ -53,6 +53,7 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkSmoothPolyDataFilter.h"
+#include "vtkRGCompatibility.h"
 #include "vtkWindowedSincPolyDataFilter.h"
 
 #include <unistd.h>
@@ -517,6 +518,9 @@ void RunCase(const Case& c, vtkMultiProcessController* controller, int cores, vt
     repair->SetSmoothingMethod(method);
     repair->SetNumberOfIterations(20);
     repair->SetRelaxationFactor(0.01);
+#if !RGMC_VTK_SINC_HAS_WINDOW_FUNCTION
+    repair->SetWindowFunction(vtkRGSeamRepair::HAMMING_WINDOW); // this VTK's only window
+#endif
     repair->Update();
     return GatherSurface(controller, repair->GetOutput());
   };

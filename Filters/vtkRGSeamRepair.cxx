@@ -613,7 +613,7 @@ public:
   /// Smooths in place (positions of this rank's vertices, in the input's precision).
   /// Returns false when aborted. Collective.
   bool Smooth(int method, int iterations, double relaxation, double passBand,
-    const std::function<bool(double)>& progress)
+    rgmc::SincWindow window, const std::function<bool(double)>& progress)
   {
     const std::size_t size = 3 * (this->N + this->RemoteGids.size());
     std::vector<T> a(size), b(size);
@@ -642,7 +642,7 @@ public:
       return true;
     }
     // Windowed sinc: x0 = a, x1 = b, x2 = c, x3 = sum.
-    const std::vector<double> coefficients = rgmc::SincCoefficients(iterations, passBand);
+    const std::vector<double> coefficients = rgmc::SincCoefficients(iterations, passBand, window);
     std::vector<T> c(size), sum(size);
     T* x0 = a.data();
     T* x1 = b.data();
@@ -967,7 +967,10 @@ int vtkRGSeamRepair::RequestData(
     if (smooth)
     {
       aborted = !repair.Smooth(this->SmoothingMethod, this->NumberOfIterations,
-        this->RelaxationFactor, this->PassBand, progress);
+        this->RelaxationFactor, this->PassBand,
+        this->WindowFunction == HAMMING_WINDOW ? rgmc::SincWindow::Hamming
+                                               : rgmc::SincWindow::Nuttall,
+        progress);
       if (!aborted)
       {
         normals = repair.Normals();
@@ -1096,5 +1099,7 @@ void vtkRGSeamRepair::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfIterations: " << this->NumberOfIterations << "\n";
   os << indent << "RelaxationFactor: " << this->RelaxationFactor << "\n";
   os << indent << "PassBand: " << this->PassBand << "\n";
+  os << indent << "WindowFunction: " << (this->WindowFunction == HAMMING_WINDOW ? "Hamming" : "Nuttall")
+     << "\n";
   os << indent << "Controller: " << this->Controller << "\n";
 }

@@ -97,6 +97,21 @@ public:
   vtkGetMacro(PassBand, double);
   ///@}
 
+  enum WindowFunctions
+  {
+    NUTTALL_WINDOW = 0,
+    HAMMING_WINDOW = 1
+  };
+
+  ///@{
+  /**
+   * Windowed-sinc window: Nuttall (default, as vtkWindowedSincPolyDataFilter's since VTK 9.4) or
+   * Hamming (VTK 9.2's, which shrinks surfaces by up to 1%).
+   */
+  vtkSetClampMacro(WindowFunction, int, NUTTALL_WINDOW, HAMMING_WINDOW);
+  vtkGetMacro(WindowFunction, int);
+  ///@}
+
   ///@{
   /**
    * The controller that links the ranks (default: the global controller).
@@ -115,6 +130,7 @@ protected:
   int NumberOfIterations = 20;
   double RelaxationFactor = 0.01;
   double PassBand = 0.1;
+  int WindowFunction = NUTTALL_WINDOW;
   vtkMultiProcessController* Controller = nullptr;
 
 private:

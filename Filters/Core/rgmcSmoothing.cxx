@@ -4,16 +4,20 @@
 namespace rgmc
 {
 
-std::vector<double> SincCoefficients(int iterations, double passBand)
+std::vector<double> SincCoefficients(int iterations, double passBand, SincWindow window)
 {
   const double pi = 3.14159265358979323846;
   const int n = iterations;
   std::vector<double> c(static_cast<std::size_t>(n) + 1, 0.0), w(c.size()), cprime(c.size());
   const double kpb = passBand;
   const double thetaPb = std::acos(1.0 - 0.5 * kpb);
+  const double m = static_cast<double>(n + 1);
   for (int i = 0; i <= n; ++i)
   {
-    w[i] = 0.54 + 0.46 * std::cos(static_cast<double>(i) * pi / static_cast<double>(n + 1));
+    const double x = static_cast<double>(i);
+    w[i] = window == SincWindow::Hamming ? 0.54 + 0.46 * std::cos(x * pi / m)
+                                         : 0.355768 + 0.487396 * std::cos(x * pi / m) +
+        0.144232 * std::cos(2.0 * x * pi / m) + 0.012604 * std::cos(3.0 * x * pi / m);
   }
   // Newton-Raphson on sigma so that the filter's transfer function is 1 at the pass band.
   double sigma = 0.0, f = 0.0;

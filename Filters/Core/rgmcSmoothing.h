@@ -2,8 +2,9 @@
 // stencils, the windowed-sinc filter's coefficients, and the update steps of Jacobi Laplacian
 // and windowed-sinc smoothing over a list of vertices.
 //
-// The stencils and the windowed-sinc steps follow vtkWindowedSincPolyDataFilter (VTK 9.2):
-// boundary smoothing on, no feature-edge smoothing, Hamming window, coordinates not normalized.
+// The stencils and the windowed-sinc steps follow vtkWindowedSincPolyDataFilter: boundary
+// smoothing on, no feature-edge smoothing, coordinates not normalized, and a Nuttall window (VTK's
+// default since 2024: its old Hamming window shrank surfaces by up to 1%) or a Hamming one.
 // Neighbours are always visited in increasing global id, so the arithmetic of every vertex is
 // fixed by the mesh alone, not by how it is distributed.
 #ifndef rgmcSmoothing_h
@@ -107,10 +108,19 @@ bool ExceedsEdgeAngle(const T* p0, const T* p1, const T* p2, double cosAngle)
   return l1[0] * l2[0] + l1[1] * l2[1] + l1[2] * l2[2] < cosAngle;
 }
 
+/// The window of the windowed-sinc filter. Nuttall is vtkWindowedSincPolyDataFilter's default
+/// from VTK 9.4 (and ParaView 5.13's VTK 9.3.20240617); Hamming was VTK 9.2's only window.
+enum class SincWindow
+{
+  Nuttall,
+  Hamming
+};
+
 /// The Chebyshev coefficients c[0..iterations] of the windowed-sinc low-pass filter, as
-/// vtkWindowedSincPolyDataFilter computes them (Hamming window, pass band widened by a
-/// Newton-Raphson search so that the filter is 1 at the pass band).
-std::vector<double> SincCoefficients(int iterations, double passBand);
+/// vtkWindowedSincPolyDataFilter computes them (the window's weights, in VTK's order of
+/// operations, and the pass band widened by a Newton-Raphson search so that the filter is 1 at
+/// the pass band).
+std::vector<double> SincCoefficients(int iterations, double passBand, SincWindow window);
 
 /// Smoothing stencils of many vertices, in compressed rows: the neighbours of vertex row r are
 /// Neighbours[Offsets[r] .. Offsets[r + 1]), indices into the point arrays.
