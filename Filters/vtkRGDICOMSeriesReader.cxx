@@ -1026,19 +1026,32 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
       if (!encapsulated && structure.PixelDataOffset > 0)
       {
         // Native pixel data: read straight from the file, swapped to this host's byte order.
+        // The byte order applies to the value's words: 8-bit samples in an OW value come in
+        // swapped pairs in big endian (pydicom 2.4's SC_rgb_small_odd_big_endian.dcm), the last
+        // one with the value's padding byte when the sample count is odd.
+        int word = in.BitsAllocated == 1 ? 1 : in.BitsAllocated / 8; // bits stay in bytes
+        if (in.BitsAllocated == 8 && structure.PixelDataWords)
+        {
+          word = 2;
+        }
+        const bool swap = structure.BigEndian && word > 1;
+        const std::size_t padded = swap && expected % word != 0 &&
+            structure.PixelDataLength >= expected + word - expected % word
+          ? expected + word - expected % word
+          : expected;
         std::ifstream file(slice.Path, std::ios::binary);
-        buffer.assign(expected, 0);
+        buffer.assign(padded, 0);
         file.seekg(static_cast<std::streamoff>(structure.PixelDataOffset));
         decoded =
-          static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(expected)));
-        const int word = in.BitsAllocated == 1 ? 1 : in.BitsAllocated / 8; // bits stay in bytes
-        if (structure.BigEndian && word > 1)
+          static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(padded)));
+        if (swap)
         {
           for (std::size_t b = 0; b + word <= buffer.size(); b += word)
           {
             std::reverse(buffer.begin() + b, buffer.begin() + b + word);
           }
         }
+        buffer.resize(expected);
         decodedPlanar = in.Planar;
       }
       else if (in.TransferSyntax == gdcm::TransferSyntax::RLELossless && in.BitsAllocated >= 8)

@@ -280,6 +280,7 @@ public:
         this->R.HasPixelData = true;
         this->R.PixelDataDeclared = e.Length;
         this->R.PixelDataOffset = this->S.InMemory ? 0 : e.Value;
+        this->R.PixelDataWords = e.VR[0] == 'O' && e.VR[1] == 'W';
         this->R.PixelDataLength =
           e.Value >= this->S.Size ? 0 : std::min<std::uint64_t>(e.Length, this->S.Size - e.Value);
         if (e.Value + e.Length > end)

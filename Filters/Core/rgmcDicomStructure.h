@@ -29,6 +29,7 @@ struct DicomStructure
   std::uint64_t PixelDataOffset = 0;   // where native pixel data starts in the file (0: not
                                        // directly readable, as in a deflated data set)
   bool BigEndian = false;              // the data set's byte order
+  bool PixelDataWords = false;         // native pixel data of VR OW (16-bit words) explicitly
   /// Encapsulated pixel data: (offset, length) of each fragment after the offset table.
   std::vector<std::pair<std::uint64_t, std::uint64_t>> Fragments;
 };
