@@ -600,6 +600,10 @@ int vtkRGMarchingCubes::RequestData(
   vtkImageData* input = vtkImageData::GetData(inputVector[0]);
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
+  // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
+  // SetAbortExecute would mark the filter modified and make it run again.
+  this->AbortExecute = 0;
 
   vtkNew<vtkDummyController> single;
   Ranks ranks(this->Controller ? this->Controller : single.Get());

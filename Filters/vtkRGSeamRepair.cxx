@@ -871,6 +871,10 @@ int vtkRGSeamRepair::RequestData(
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
   vtkNew<vtkDummyController> single;
   Ranks ranks(this->Controller ? this->Controller : single.Get());
+  // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
+  // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
+  // SetAbortExecute would mark the filter modified and make it run again.
+  this->AbortExecute = 0;
 
   // PASS 0: a triangle mesh, on every rank.
   std::string problem;

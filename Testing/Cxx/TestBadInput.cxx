@@ -199,6 +199,14 @@ int main()
     rg->Update();
     RGMC_CHECK(rg->GetOutput()->GetNumberOfCells() == 0,
       "an aborted run leaves an empty output, not " << rg->GetOutput()->GetNumberOfCells());
+    // The next run, with nothing reset by the caller (as ParaView's next Apply; VTK 9.3+ keeps
+    // an algorithm's abort flag between runs), extracts the whole surface again.
+    rg->RemoveObserver(abort);
+    rg->SetIsovalue(400);
+    rg->Update();
+    RGMC_CHECK(rg->GetOutput()->GetNumberOfCells() == full,
+      "after an abort, the next run gives " << rg->GetOutput()->GetNumberOfCells()
+                                            << " triangles, not " << full);
   }
   return rgmc_test::Result("TestBadInput");
 }
