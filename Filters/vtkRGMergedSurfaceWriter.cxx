@@ -1,33 +1,741 @@
-// Writes a distributed surface as one mesh: gathered on the first rank, points merged by
-// global id.
+// Writes a distributed surface as one mesh without gathering it: every rank writes its own
+// records into the one file at offsets that every rank can compute (see the header).
 #include "vtkRGMergedSurfaceWriter.h"
 
 #include "vtkRGCollective.h"
+#include "vtkRGSeamRepair.h"
 
-#include "vtkAppendPolyData.h"
+#include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"
-#include "vtkCellData.h"
+#include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDummyController.h"
+#include "vtkFieldData.h"
+#include "vtkIdList.h"
 #include "vtkIdTypeArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
-#include "vtkPLYWriter.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkSTLWriter.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkXMLPolyDataWriter.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkXMLPPolyDataWriter.h"
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <limits>
+#include <new>
 #include <string>
-#include <unordered_map>
+#include <unistd.h>
+#include <utility>
+#include <vector>
 
 vtkStandardNewMacro(vtkRGMergedSurfaceWriter);
 vtkCxxSetObjectMacro(vtkRGMergedSurfaceWriter, Controller, vtkMultiProcessController);
+
+namespace
+{
+using Int = std::int64_t;
+
+/// A file of which this rank writes byte ranges (POSIX pwrite). Records at consecutive offsets
+/// are buffered and go out in one call; the first failure is kept, with the system's reason.
+class RangeFile
+{
+public:
+  ~RangeFile() { this->Close(); }
+
+  bool Open(const std::string& path, bool create)
+  {
+    this->Path = path;
+    this->Descriptor =
+      ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (create ? O_CREAT | O_TRUNC : 0), 0666);
+    if (this->Descriptor < 0)
+    {
+      this->Fail(create ? "cannot create " : "cannot open ");
+    }
+    return !this->Failed;
+  }
+
+  void Write(Int offset, const char* data, std::size_t size)
+  {
+    if (this->Failed)
+    {
+      return;
+    }
+    if (!this->Buffer.empty() &&
+      offset != this->BufferStart + static_cast<Int>(this->Buffer.size()))
+    {
+      this->Flush();
+    }
+    if (this->Buffer.empty())
+    {
+      this->BufferStart = offset;
+    }
+    this->Buffer.insert(this->Buffer.end(), data, data + size);
+    if (this->Buffer.size() >= Capacity)
+    {
+      this->Flush();
+    }
+  }
+
+  bool Flush()
+  {
+    std::size_t done = 0;
+    while (!this->Failed && done < this->Buffer.size())
+    {
+      const ssize_t n = ::pwrite(this->Descriptor, this->Buffer.data() + done,
+        this->Buffer.size() - done, static_cast<off_t>(this->BufferStart + static_cast<Int>(done)));
+      if (n < 0 && errno == EINTR)
+      {
+        continue;
+      }
+      if (n <= 0)
+      {
+        if (n == 0)
+        {
+          errno = ENOSPC;
+        }
+        this->Fail("cannot write ");
+      }
+      else
+      {
+        done += static_cast<std::size_t>(n);
+      }
+    }
+    this->Buffer.clear();
+    return !this->Failed;
+  }
+
+  bool Close()
+  {
+    if (this->Descriptor >= 0)
+    {
+      this->Flush();
+      if (::close(this->Descriptor) != 0 && !this->Failed)
+      {
+        this->Fail("cannot close ");
+      }
+      this->Descriptor = -1;
+    }
+    return !this->Failed;
+  }
+
+  bool Failed = false;
+  std::string Problem;
+
+private:
+  static constexpr std::size_t Capacity = std::size_t(4) << 20;
+
+  void Fail(const char* what)
+  {
+    const int error = errno;
+    this->Failed = true;
+    this->Problem = std::string(what) + this->Path + ": " + std::strerror(error);
+  }
+
+  std::string Path;
+  int Descriptor = -1;
+  Int BufferStart = 0;
+  std::vector<char> Buffer;
+};
+
+/// A run of fixed-size records in the file: record i lies at Start + i * Size.
+struct Block
+{
+  Int Start = 0;
+  Int Size = 0;
+};
+
+/// Where everything goes in the file: the texts that rank 0 writes, and the record blocks.
+struct Layout
+{
+  std::vector<std::pair<Int, std::string>> Texts;
+  Int End = 0;
+
+  void Text(const std::string& text)
+  {
+    this->Texts.emplace_back(this->End, text);
+    this->End += static_cast<Int>(text.size());
+  }
+  Block Records(Int count, Int size)
+  {
+    Block b{ this->End, size };
+    this->End += count * size;
+    return b;
+  }
+};
+
+// Little-endian bytes whatever the host.
+template <typename T>
+char* PutLittleEndian(char* out, T value)
+{
+  unsigned char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  const std::uint16_t one = 1;
+  if (*reinterpret_cast<const unsigned char*>(&one) == 0)
+  {
+    std::reverse(bytes, bytes + sizeof(T));
+  }
+  std::memcpy(out, bytes, sizeof(T));
+  return out + sizeof(T);
+}
+
+const char Base64Digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Base64 of `size` bytes; a multiple of 3 gives no padding, so such records concatenate into
+/// one valid stream.
+std::string Base64(const char* data, std::size_t size)
+{
+  std::string out;
+  const auto* in = reinterpret_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; i += 3)
+  {
+    const unsigned a = in[i], b = i + 1 < size ? in[i + 1] : 0, c = i + 2 < size ? in[i + 2] : 0;
+    out += Base64Digits[a >> 2];
+    out += Base64Digits[((a & 3) << 4) | (b >> 4)];
+    out += i + 1 < size ? Base64Digits[((b & 15) << 2) | (c >> 6)] : '=';
+    out += i + 2 < size ? Base64Digits[c & 63] : '=';
+  }
+  return out;
+}
+
+/// Text of fixed width: a number with its sign or a space, in scientific notation with all the digits its type
+/// needs to read back exactly (9 significant digits for float, 17 for double). Returns the
+/// length: 15 for float, 23 for double; anything else (not finite, or a double beyond 1e100)
+/// does not fit the file's fixed-width records.
+int FixedReal(char* out, double value, bool isDouble)
+{
+  // A space, not '+', before positive numbers: VTK 9.3's PLY reader reads "+1.5" as 0.
+  return std::snprintf(out, 32, isDouble ? "% .16e" : "% .8e",
+    isDouble ? value : static_cast<double>(static_cast<float>(value)));
+}
+
+/// Number of decimal digits of the largest of `value` and 1.
+int Digits(Int value)
+{
+  int digits = 1;
+  for (; value >= 10; value /= 10)
+  {
+    ++digits;
+  }
+  return digits;
+}
+
+enum class Format
+{
+  STL,
+  PLY,
+  VTP
+};
+
+/// This rank's part of the mesh, in the file's terms.
+struct Mesh
+{
+  vtkPoints* Points = nullptr;
+  vtkDataArray* Normals = nullptr;              // 3 components, or none
+  std::vector<std::pair<Int, vtkIdType>> Owned; // (global id, local point), by global id
+  std::vector<Int> Gid;                         // global id of each local point
+  std::vector<vtkIdType> Triangles;             // 3 local points each
+};
+
+enum class Collected
+{
+  Numbered,    // Seam Repair's numbering: contiguous global ids, duplicates flagged
+  NotNumbered, // anything else: the writer numbers it first
+  OutOfMemory
+};
+
+/// Collects what this rank writes.
+Collected Collect(vtkPolyData* pd, Mesh& mesh)
+{
+  mesh = Mesh();
+  try
+  {
+    mesh.Points = pd->GetPoints();
+    const vtkIdType n = pd->GetNumberOfPoints();
+    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+    vtkUnsignedCharArray* ghosts = vtkUnsignedCharArray::SafeDownCast(
+      pd->GetPointData()->GetArray(vtkDataSetAttributes::GhostArrayName()));
+    if (pd->GetNumberOfVerts() + pd->GetNumberOfLines() + pd->GetNumberOfStrips() > 0 ||
+      (n > 0 && (!ids || !ghosts || !pd->GetFieldData()->GetArray("UniquePoints"))))
+    {
+      return Collected::NotNumbered;
+    }
+    mesh.Gid.resize(static_cast<std::size_t>(n));
+    for (vtkIdType p = 0; p < n; ++p)
+    {
+      mesh.Gid[p] = ids->GetValue(p);
+      if ((ghosts->GetValue(p) & vtkDataSetAttributes::DUPLICATEPOINT) == 0)
+      {
+        mesh.Owned.emplace_back(mesh.Gid[p], p);
+      }
+    }
+    std::sort(mesh.Owned.begin(), mesh.Owned.end());
+    vtkDataArray* normals = pd->GetPointData()->GetNormals();
+    mesh.Normals = normals && normals->GetNumberOfComponents() == 3 ? normals : nullptr;
+    vtkCellArray* polys = pd->GetPolys();
+    mesh.Triangles.reserve(static_cast<std::size_t>(3 * polys->GetNumberOfCells()));
+    vtkNew<vtkIdList> cell;
+    for (vtkIdType c = 0; c < polys->GetNumberOfCells(); ++c)
+    {
+      polys->GetCellAtId(c, cell); // any storage, also VTK 9.6's fixed-size cell arrays
+      if (cell->GetNumberOfIds() != 3)
+      {
+        return Collected::NotNumbered; // Seam Repair's numbering names the problem
+      }
+      mesh.Triangles.insert(mesh.Triangles.end(), cell->begin(), cell->end());
+    }
+  }
+  catch (const std::bad_alloc&)
+  {
+    mesh = Mesh();
+    return Collected::OutOfMemory;
+  }
+  return Collected::Numbered;
+}
+
+/// Whether the numbering is one this writer can place: every global id in [0, vertices), each
+/// owned once.
+bool Placeable(const Mesh& mesh, Int vertices)
+{
+  for (Int g : mesh.Gid)
+  {
+    if (g < 0 || g >= vertices)
+    {
+      return false;
+    }
+  }
+  for (std::size_t i = 1; i < mesh.Owned.size(); ++i)
+  {
+    if (mesh.Owned[i].first == mesh.Owned[i - 1].first)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Records the first error message of `object` (and of what it runs) for the caller.
+struct ErrorCatcher
+{
+  std::string Message;
+  vtkNew<vtkCallbackCommand> Command;
+  explicit ErrorCatcher(vtkObject* object)
+  {
+    this->Command->SetClientData(this);
+    this->Command->SetCallback([](vtkObject*, unsigned long, void* self, void* text) {
+      auto* catcher = static_cast<ErrorCatcher*>(self);
+      if (catcher->Message.empty() && text)
+      {
+        catcher->Message = static_cast<const char*>(text);
+      }
+    });
+    object->AddObserver(vtkCommand::ErrorEvent, this->Command);
+  }
+};
+
+/// One format's file: its layout (the same on every rank) and this rank's records.
+class MergedFile
+{
+public:
+  MergedFile(Format format, bool binary, const Mesh& mesh, Int vertices, Int triangles,
+    Int firstTriangle, bool normals, bool doublePoints)
+    : Kind(format)
+    , Binary(binary)
+    , M(mesh)
+    , Vertices(vertices)
+    , Triangles(triangles)
+    , FirstTriangle(firstTriangle)
+    , WithNormals(normals)
+    , DoublePoints(doublePoints)
+  {
+  }
+
+  /// Why this mesh cannot be written in this format (empty when it can).
+  std::string Limit() const
+  {
+    const Int u32 = std::numeric_limits<std::uint32_t>::max();
+    if (this->Kind == Format::STL && this->Binary && this->Triangles > u32)
+    {
+      return "a binary STL file holds at most 4294967295 triangles (its count is 32-bit); this "
+             "surface has " +
+        std::to_string(this->Triangles) + ": write PLY, VTP or PVTP";
+    }
+    if (this->Kind == Format::PLY && this->Vertices > u32)
+    {
+      return "a PLY file's vertex indices are at most 32-bit; this surface has " +
+        std::to_string(this->Vertices) + " vertices: write VTP or PVTP";
+    }
+    return std::string();
+  }
+
+  /// Lays the file out: every record's size comes from formatting a sample record, so the
+  /// layout and the records cannot disagree.
+  void Plan()
+  {
+    this->IdWidth = Digits(std::max<Int>(this->Vertices - 1, 0));
+    this->OffsetWidth = Digits(3 * this->Triangles);
+    const double zero[3] = { 0, 0, 0 };
+    const vtkIdType sample[3] = { 0, 0, 0 };
+    char buffer[RecordCapacity];
+    const Int point = this->PointLength = this->PointRecord(buffer, zero, this->DoublePoints);
+    const Int normal = this->NormalLength =
+      this->WithNormals ? this->PointRecord(buffer, zero, false) : 0;
+    const Int triangle = this->TriangleLength = this->TriangleRecord(buffer, sample, true);
+    const Int offset = this->OffsetLength = this->OffsetRecord(buffer, 0);
+    switch (this->Kind)
+    {
+      case Format::STL:
+        if (this->Binary)
+        {
+          std::string header = "RGMC merged surface (binary STL)";
+          header.resize(80, ' ');
+          char count[4];
+          PutLittleEndian(count, static_cast<std::uint32_t>(this->Triangles));
+          this->L.Text(header + std::string(count, 4));
+          this->TriangleBlock = this->L.Records(this->Triangles, triangle);
+        }
+        else
+        {
+          this->L.Text("solid rgmc\n");
+          this->TriangleBlock = this->L.Records(this->Triangles, triangle);
+          this->L.Text("endsolid rgmc\n");
+        }
+        break;
+      case Format::PLY:
+      {
+        const std::string real = this->DoublePoints ? "double" : "float";
+        std::string header = std::string("ply\nformat ") +
+          (this->Binary ? "binary_little_endian" : "ascii") +
+          " 1.0\ncomment RGMC merged surface\nelement vertex " + std::to_string(this->Vertices) +
+          "\nproperty " + real + " x\nproperty " + real + " y\nproperty " + real + " z\n";
+        if (this->WithNormals)
+        {
+          header += "property float nx\nproperty float ny\nproperty float nz\n";
+        }
+        header += "element face " + std::to_string(this->Triangles) + "\nproperty list uchar " +
+          (this->Vertices > std::numeric_limits<std::int32_t>::max() ? "uint" : "int") +
+          " vertex_indices\nend_header\n";
+        this->L.Text(header);
+        // A PLY vertex is its coordinates then its normal: one record of both.
+        this->PointBlock = this->L.Records(this->Vertices, point + normal);
+        this->NormalBlock = Block{ this->PointBlock.Start + point, point + normal };
+        this->TriangleBlock = this->L.Records(this->Triangles, triangle);
+        break;
+      }
+      case Format::VTP:
+      {
+        const Int realBytes = this->DoublePoints ? 8 : 4;
+        this->L.Text("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
+                     "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PolyData>\n    "
+                     "<Piece NumberOfPoints=\"" +
+          std::to_string(this->Vertices) +
+          "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
+          std::to_string(this->Triangles) + "\">\n");
+        if (this->WithNormals)
+        {
+          this->L.Text("      <PointData Normals=\"Normals\">\n" +
+            this->ArrayStart("Float32", "Normals", 3, 12 * this->Vertices, this->Binary));
+          this->NormalBlock = this->L.Records(this->Vertices, normal);
+          this->L.Text("\n        </DataArray>\n      </PointData>\n");
+        }
+        this->L.Text("      <Points>\n" +
+          this->ArrayStart(this->DoublePoints ? "Float64" : "Float32", "Points", 3,
+            3 * realBytes * this->Vertices, this->Binary));
+        this->PointBlock = this->L.Records(this->Vertices, point);
+        this->L.Text("\n        </DataArray>\n      </Points>\n      <Polys>\n" +
+          this->ArrayStart("Int64", "connectivity", 1, 24 * this->Triangles, this->Binary));
+        this->TriangleBlock = this->L.Records(this->Triangles, triangle);
+        // 8-byte offsets cannot be placed by byte range in base64: fixed-width text always.
+        this->L.Text("\n        </DataArray>\n" + this->ArrayStart("Int64", "offsets", 1, 0, false));
+        this->OffsetBlock = this->L.Records(this->Triangles, offset);
+        this->L.Text(
+          "        </DataArray>\n      </Polys>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
+        break;
+      }
+    }
+  }
+
+  /// Writes this rank's records (and, with `texts`, the headers). Records go out in file order
+  /// where possible, so that the file sees long runs. False with Problem on bad values.
+  bool Write(RangeFile& file, bool texts)
+  {
+    if (texts)
+    {
+      for (const auto& text : this->L.Texts)
+      {
+        file.Write(text.first, text.second.data(), text.second.size());
+      }
+    }
+    char record[RecordCapacity];
+    const bool interleaved = this->Kind == Format::PLY;
+    for (const auto& owned : this->M.Owned)
+    {
+      if (this->Kind == Format::STL)
+      {
+        break;
+      }
+      double x[3];
+      this->M.Points->GetPoint(owned.second, x);
+      const char end = interleaved && this->WithNormals ? ' ' : '\n';
+      if (!this->Put(file, this->PointBlock, owned.first,
+            this->PointRecord(record, x, this->DoublePoints, end), this->PointLength, record))
+      {
+        return false;
+      }
+      if (interleaved && this->WithNormals)
+      {
+        this->M.Normals->GetTuple(owned.second, x);
+        if (!this->Put(file, this->NormalBlock, owned.first, this->PointRecord(record, x, false),
+              this->NormalLength, record))
+        {
+          return false;
+        }
+      }
+    }
+    if (!interleaved && this->WithNormals)
+    {
+      for (const auto& owned : this->M.Owned)
+      {
+        double n[3];
+        this->M.Normals->GetTuple(owned.second, n);
+        if (!this->Put(file, this->NormalBlock, owned.first, this->PointRecord(record, n, false),
+              this->NormalLength, record))
+        {
+          return false;
+        }
+      }
+    }
+    const Int count = static_cast<Int>(this->M.Triangles.size() / 3);
+    for (Int t = 0; t < count; ++t)
+    {
+      const Int index = this->FirstTriangle + t;
+      if (!this->Put(file, this->TriangleBlock, index,
+            this->TriangleRecord(record, &this->M.Triangles[3 * t], false), this->TriangleLength,
+            record))
+      {
+        return false;
+      }
+    }
+    for (Int t = 0; this->Kind == Format::VTP && t < count; ++t)
+    {
+      const Int index = this->FirstTriangle + t;
+      if (!this->Put(file, this->OffsetBlock, index, this->OffsetRecord(record, index),
+            this->OffsetLength, record))
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  Int Size() const { return this->L.End; }
+  std::string Problem;
+
+private:
+  static constexpr std::size_t RecordCapacity = 1024;
+
+  // Places a record of `length` bytes, which must be `expected`, at index `index` of `block`.
+  bool Put(
+    RangeFile& file, const Block& block, Int index, Int length, Int expected, const char* record)
+  {
+    if (length != expected)
+    {
+      this->Problem = "a coordinate or normal is not a finite number (or is beyond 1e100), so "
+                      "it has no fixed-width text form";
+      return false;
+    }
+    file.Write(block.Start + index * block.Size, record, static_cast<std::size_t>(length));
+    return true;
+  }
+
+  // Coordinates or a normal: binary (base64 in VTP) or fixed-width text ending with `end`
+  // (a PLY vertex's coordinates and normal share one line).
+  Int PointRecord(char* out, const double v[3], bool isDouble, char end = '\n') const
+  {
+    if (this->Binary)
+    {
+      char bytes[24];
+      char* end = bytes;
+      for (int k = 0; k < 3; ++k)
+      {
+        end = isDouble ? PutLittleEndian(end, v[k]) : PutLittleEndian(end, static_cast<float>(v[k]));
+      }
+      if (this->Kind == Format::VTP)
+      {
+        const std::string text = Base64(bytes, static_cast<std::size_t>(end - bytes));
+        std::memcpy(out, text.data(), text.size());
+        return static_cast<Int>(text.size());
+      }
+      std::memcpy(out, bytes, static_cast<std::size_t>(end - bytes));
+      return end - bytes;
+    }
+    Int length = 0;
+    for (int k = 0; k < 3; ++k)
+    {
+      const int written = FixedReal(out + length, v[k], isDouble);
+      if (written != (isDouble ? 23 : 15))
+      {
+        return -1;
+      }
+      length += written;
+      out[length++] = k < 2 ? ' ' : end;
+    }
+    return length;
+  }
+
+  // One triangle: STL's facet with its own normal and vertices, PLY's face, VTP's connectivity.
+  Int TriangleRecord(char* out, const vtkIdType* local, bool sample) const
+  {
+    char* start = out;
+    if (this->Kind == Format::STL)
+    {
+      float f[3][3] = {};
+      for (int v = 0; v < 3 && !sample; ++v)
+      {
+        double x[3];
+        this->M.Points->GetPoint(local[v], x);
+        for (int k = 0; k < 3; ++k)
+        {
+          f[v][k] = static_cast<float>(x[k]);
+        }
+      }
+      double a[3], b[3], n[3];
+      for (int k = 0; k < 3; ++k)
+      {
+        a[k] = static_cast<double>(f[1][k]) - f[0][k];
+        b[k] = static_cast<double>(f[2][k]) - f[0][k];
+      }
+      n[0] = a[1] * b[2] - a[2] * b[1];
+      n[1] = a[2] * b[0] - a[0] * b[2];
+      n[2] = a[0] * b[1] - a[1] * b[0];
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int k = 0; k < 3 && length > 0; ++k)
+      {
+        n[k] /= length;
+      }
+      if (this->Binary)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          out = PutLittleEndian(out, static_cast<float>(n[k]));
+        }
+        for (int v = 0; v < 3; ++v)
+        {
+          for (int k = 0; k < 3; ++k)
+          {
+            out = PutLittleEndian(out, f[v][k]);
+          }
+        }
+        out = PutLittleEndian(out, std::uint16_t(0));
+        return out - start;
+      }
+      char r[3][32];
+      auto reals = [&r](const double* values) {
+        for (int k = 0; k < 3; ++k)
+        {
+          if (FixedReal(r[k], values[k], false) != 15)
+          {
+            return false;
+          }
+        }
+        return true;
+      };
+      if (!reals(n))
+      {
+        return -1;
+      }
+      out += std::sprintf(out, "facet normal %s %s %s\n  outer loop\n", r[0], r[1], r[2]);
+      for (int v = 0; v < 3; ++v)
+      {
+        const double x[3] = { f[v][0], f[v][1], f[v][2] };
+        if (!reals(x))
+        {
+          return -1;
+        }
+        out += std::sprintf(out, "    vertex %s %s %s\n", r[0], r[1], r[2]);
+      }
+      out += std::sprintf(out, "  endloop\nendfacet\n");
+      return out - start;
+    }
+    const Int g[3] = { sample ? 0 : this->M.Gid[local[0]], sample ? 0 : this->M.Gid[local[1]],
+      sample ? 0 : this->M.Gid[local[2]] };
+    const bool wide = this->Vertices > std::numeric_limits<std::int32_t>::max();
+    if (this->Kind == Format::PLY && this->Binary)
+    {
+      *out++ = 3;
+      for (Int id : g)
+      {
+        out = wide ? PutLittleEndian(out, static_cast<std::uint32_t>(id))
+                   : PutLittleEndian(out, static_cast<std::int32_t>(id));
+      }
+      return out - start;
+    }
+    if (this->Kind == Format::VTP && this->Binary)
+    {
+      char bytes[24];
+      char* end = bytes;
+      for (Int id : g)
+      {
+        end = PutLittleEndian(end, static_cast<std::int64_t>(id));
+      }
+      const std::string text = Base64(bytes, 24);
+      std::memcpy(out, text.data(), text.size());
+      return static_cast<Int>(text.size());
+    }
+    // Right-aligned with spaces, not zeros: VTK 9.3's PLY reader reads "010" as octal.
+    return std::sprintf(out, this->Kind == Format::PLY ? "3 %*lld %*lld %*lld\n" : "%*lld %*lld %*lld\n",
+      this->IdWidth, static_cast<long long>(g[0]), this->IdWidth, static_cast<long long>(g[1]),
+      this->IdWidth, static_cast<long long>(g[2]));
+  }
+
+  // VTP's offset of triangle `index`: where its connectivity ends.
+  Int OffsetRecord(char* out, Int index) const
+  {
+    return std::sprintf(out, "%*lld\n", this->OffsetWidth, static_cast<long long>(3 * (index + 1)));
+  }
+
+  // A DataArray's opening tag and, in binary, its base64 header (the byte count, encoded apart
+  // from the data, as VTK's writer does).
+  static std::string ArrayStart(
+    const char* type, const char* name, int components, Int bytes, bool binary)
+  {
+    std::string text = std::string("        <DataArray type=\"") + type + "\" Name=\"" + name + "\"";
+    if (components > 1)
+    {
+      text += " NumberOfComponents=\"" + std::to_string(components) + "\"";
+    }
+    text += std::string(" format=\"") + (binary ? "binary" : "ascii") + "\">\n";
+    if (binary)
+    {
+      char header[8];
+      PutLittleEndian(header, static_cast<std::uint64_t>(bytes));
+      text += Base64(header, 8);
+    }
+    return text;
+  }
+
+  Format Kind;
+  bool Binary;
+  const Mesh& M;
+  Int Vertices, Triangles, FirstTriangle;
+  bool WithNormals, DoublePoints;
+  Layout L;
+  Block PointBlock, NormalBlock, TriangleBlock, OffsetBlock;
+  Int PointLength = 0, NormalLength = 0, TriangleLength = 0, OffsetLength = 0;
+  int IdWidth = 1, OffsetWidth = 1;
+};
+
+} // namespace
 
 //------------------------------------------------------------------------------
 vtkRGMergedSurfaceWriter::vtkRGMergedSurfaceWriter()
@@ -55,7 +763,7 @@ vtkTypeBool vtkRGMergedSurfaceWriter::ProcessRequest(
 {
   if (request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) && this->Controller)
   {
-    // Each rank writes its own piece into the gathered file.
+    // Each rank writes its own piece into the file.
     vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
     inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(),
       this->Controller->GetLocalProcessId());
@@ -68,89 +776,17 @@ vtkTypeBool vtkRGMergedSurfaceWriter::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------
-vtkSmartPointer<vtkPolyData> vtkRGMergedSurfaceWriter::Merge(
-  const std::vector<vtkSmartPointer<vtkDataObject>>& pieces)
-{
-  vtkNew<vtkAppendPolyData> append;
-  bool keyed = true;
-  int inputs = 0;
-  for (const auto& piece : pieces)
-  {
-    vtkPolyData* pd = vtkPolyData::SafeDownCast(piece);
-    if (pd && pd->GetNumberOfPoints() > 0)
-    {
-      keyed = keyed && vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds()) != nullptr;
-      append->AddInputData(pd);
-      ++inputs;
-    }
-  }
-  auto merged = vtkSmartPointer<vtkPolyData>::New();
-  if (inputs == 0)
-  {
-    return merged;
-  }
-  append->Update();
-  vtkPolyData* all = append->GetOutput();
-  vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(all->GetPointData()->GetGlobalIds());
-  if (!keyed || !ids)
-  {
-    merged->ShallowCopy(all);
-    return merged;
-  }
-  // One point per global id: the first copy.
-  const vtkIdType n = all->GetNumberOfPoints();
-  std::unordered_map<vtkIdType, vtkIdType> first;
-  first.reserve(static_cast<std::size_t>(n));
-  std::vector<vtkIdType> newId(static_cast<std::size_t>(n));
-  std::vector<vtkIdType> kept;
-  for (vtkIdType p = 0; p < n; ++p)
-  {
-    auto inserted = first.emplace(ids->GetValue(p), static_cast<vtkIdType>(kept.size()));
-    if (inserted.second)
-    {
-      kept.push_back(p);
-    }
-    newId[p] = inserted.first->second;
-  }
-  vtkNew<vtkPoints> points;
-  points->SetDataType(all->GetPoints()->GetDataType());
-  points->SetNumberOfPoints(static_cast<vtkIdType>(kept.size()));
-  vtkPointData* pd = merged->GetPointData();
-  pd->CopyAllocate(all->GetPointData(), static_cast<vtkIdType>(kept.size()));
-  for (vtkIdType k = 0; k < static_cast<vtkIdType>(kept.size()); ++k)
-  {
-    points->SetPoint(k, all->GetPoint(kept[k]));
-    pd->CopyData(all->GetPointData(), kept[k], k);
-  }
-  pd->RemoveArray(vtkDataSetAttributes::GhostArrayName()); // one file has no duplicates
-  vtkNew<vtkCellArray> polys;
-  vtkCellArray* in = all->GetPolys();
-  polys->AllocateExact(in->GetNumberOfCells(), in->GetNumberOfConnectivityIds());
-  vtkIdType npts;
-  const vtkIdType* pts;
-  std::vector<vtkIdType> cell;
-  for (in->InitTraversal(); in->GetNextCell(npts, pts);)
-  {
-    cell.assign(pts, pts + npts);
-    for (vtkIdType& id : cell)
-    {
-      id = newId[id];
-    }
-    polys->InsertNextCell(npts, cell.data());
-  }
-  merged->SetPoints(points);
-  merged->SetPolys(polys);
-  merged->GetCellData()->ShallowCopy(all->GetCellData());
-  return merged;
-}
-
-//------------------------------------------------------------------------------
 void vtkRGMergedSurfaceWriter::WriteData()
 {
   vtkNew<vtkDummyController> single;
   rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
   vtkPolyData* input = vtkPolyData::SafeDownCast(this->GetInput());
+  auto fail = [this](const std::string& problem) {
+    vtkErrorMacro(<< "Cannot write the surface: " << problem << ".");
+    this->SetErrorCode(1);
+  };
 
+  // PASS 1: the file name and the format, agreed.
   std::string problem;
   const std::string name = this->FileName ? this->FileName : "";
   const std::size_t dot = name.find_last_of('.');
@@ -159,69 +795,168 @@ void vtkRGMergedSurfaceWriter::WriteData()
   {
     problem = "no file name is set";
   }
-  else if (extension != "stl" && extension != "ply" && extension != "vtp")
+  else if (extension != "stl" && extension != "ply" && extension != "vtp" && extension != "pvtp")
   {
-    problem = "the file name " + name + " must end in .stl, .ply or .vtp";
+    problem = "the file name " + name + " must end in .stl, .ply, .vtp or .pvtp";
   }
   if (!ranks.Agree(problem.empty(), problem))
   {
-    vtkErrorMacro(<< "Cannot write the surface: " << problem << ".");
-    this->SetErrorCode(1);
+    fail(problem);
     return;
   }
-
-  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
-  vtkNew<vtkPolyData> mine;
+  vtkNew<vtkPolyData> surface;
   if (input)
   {
-    mine->ShallowCopy(input);
+    surface->ShallowCopy(input);
   }
-  ranks.C->Gather(mine, pieces, 0);
-  bool ok = true;
-  if (ranks.Rank == 0)
+
+  if (extension == "pvtp")
   {
-    vtkSmartPointer<vtkPolyData> merged = Merge(pieces);
-    if (extension == "stl")
+    // ParaView's parallel form: each rank's piece as it is, and the index on rank 0.
+    vtkNew<vtkXMLPPolyDataWriter> pieces;
+    ErrorCatcher catcher(pieces);
+    pieces->SetController(ranks.C);
+    pieces->SetNumberOfPieces(ranks.Size);
+    pieces->SetStartPiece(ranks.Rank);
+    pieces->SetEndPiece(ranks.Rank);
+    pieces->SetFileName(name.c_str());
+    if (this->FileType == VTK_ASCII)
     {
-      vtkNew<vtkSTLWriter> stl;
-      stl->SetFileType(this->FileType);
-      stl->SetFileName(name.c_str());
-      stl->SetInputData(merged);
-      ok = stl->Write() != 0 && stl->GetErrorCode() == 0;
-    }
-    else if (extension == "ply")
-    {
-      vtkNew<vtkPLYWriter> ply;
-      ply->SetFileType(this->FileType);
-      ply->SetFileName(name.c_str());
-      ply->SetInputData(merged);
-      ok = ply->Write() != 0 && ply->GetErrorCode() == 0;
+      pieces->SetDataModeToAscii();
     }
     else
     {
-      vtkNew<vtkXMLPolyDataWriter> vtp;
-      if (this->FileType == VTK_ASCII)
-      {
-        vtp->SetDataModeToAscii();
-      }
-      else
-      {
-        vtp->SetDataModeToBinary(); // inline: appended data does not load on Debian 12
-      }
-      vtp->SetFileName(name.c_str());
-      vtp->SetInputData(merged);
-      ok = vtp->Write() != 0 && vtp->GetErrorCode() == 0;
+      pieces->SetDataModeToBinary(); // inline: appended data does not load on Debian 12
     }
-    if (!ok)
+    pieces->SetInputData(surface);
+    const bool ok = pieces->Write() != 0 && pieces->GetErrorCode() == 0;
+    problem = catcher.Message.empty() ? "could not write " + name : catcher.Message;
+    if (!ranks.Agree(ok, problem))
     {
-      problem = "could not write " + name;
+      fail(problem);
+    }
+    return;
+  }
+
+  // PASS 2: the surface numbered as one mesh: Seam Repair's numbering when the input has it,
+  // otherwise numbered here (by Seam Repair without smoothing, which also names what is not a
+  // triangle mesh), and the global counts with this rank's first triangle.
+  Mesh mesh;
+  Int vertices = 0, triangles = 0, firstTriangle = 0;
+  bool normals = true;
+  for (int attempt = 0;; ++attempt)
+  {
+    const Collected collected = Collect(surface, mesh);
+    problem = "out of memory while collecting this rank's vertices and triangles";
+    if (!ranks.Agree(collected != Collected::OutOfMemory, problem))
+    {
+      fail(problem);
+      return;
+    }
+    Int local[3] = { static_cast<Int>(mesh.Owned.size()),
+      static_cast<Int>(mesh.Triangles.size() / 3),
+      surface->GetNumberOfPoints() > 0 && !mesh.Normals ? 1 : 0 };
+    std::vector<Int> all(3 * static_cast<std::size_t>(ranks.Size));
+    if (ranks.C->AllGather(local, all.data(), 3) == 0)
+    {
+      fail("the ranks could not exchange their counts");
+      return;
+    }
+    vertices = triangles = firstTriangle = 0;
+    normals = true;
+    for (int r = 0; r < ranks.Size; ++r)
+    {
+      if (r == ranks.Rank)
+      {
+        firstTriangle = triangles;
+      }
+      vertices += all[3 * r];
+      triangles += all[3 * r + 1];
+      normals = normals && all[3 * r + 2] == 0;
+    }
+    const bool ready =
+      collected == Collected::Numbered && Placeable(mesh, vertices);
+    if (!ranks.Any(!ready))
+    {
+      break;
+    }
+    if (attempt > 0)
+    {
+      fail("Seam Repair's numbering of the surface is not contiguous");
+      return;
+    }
+    vtkNew<vtkRGSeamRepair> numbering;
+    ErrorCatcher catcher(numbering);
+    numbering->SetController(ranks.C);
+    numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
+    numbering->SetInputData(surface);
+    numbering->Update(); // collective; it agrees its errors over the ranks itself
+    problem = "it cannot be numbered as one mesh: " + catcher.Message;
+    if (!ranks.Agree(catcher.Message.empty(), problem))
+    {
+      fail(problem);
+      return;
+    }
+    auto numbered = vtkSmartPointer<vtkPolyData>::New();
+    numbered->ShallowCopy(numbering->GetOutput());
+    surface->ShallowCopy(numbered);
+  }
+  normals = normals && extension != "stl" && vertices > 0;
+  const Format format =
+    extension == "stl" ? Format::STL : (extension == "ply" ? Format::PLY : Format::VTP);
+  // The points' type is in the header: double when any rank has double points.
+  const bool doublePoints = ranks.Any(
+    format != Format::STL && mesh.Points && mesh.Points->GetDataType() == VTK_DOUBLE);
+  MergedFile file(format, this->FileType != VTK_ASCII, mesh, vertices, triangles, firstTriangle,
+    normals, doublePoints);
+  problem = file.Limit();
+  if (!problem.empty())
+  {
+    fail(problem); // the same on every rank: the counts are global
+    return;
+  }
+  file.Plan();
+
+  // PASS 3: rank 0 creates the file, then every other rank opens it.
+  RangeFile out;
+  bool ok = ranks.Rank != 0 || out.Open(name, true);
+  if (!ranks.Agree(ok, out.Problem))
+  {
+    fail(out.Problem);
+    return;
+  }
+  ok = ranks.Rank == 0 || out.Open(name, false);
+  problem = out.Problem;
+  if (ranks.Agree(ok, problem))
+  {
+    // PASS 4: every rank writes its records; rank 0 also the texts.
+    bool written = false;
+    try
+    {
+      written = file.Write(out, ranks.Rank == 0);
+      problem = file.Problem;
+    }
+    catch (const std::bad_alloc&)
+    {
+      problem = "out of memory while writing " + name;
+    }
+    ok = out.Close() && written;
+    if (!out.Problem.empty())
+    {
+      problem = out.Problem;
+    }
+    if (ranks.Agree(ok, problem))
+    {
+      return;
     }
   }
-  if (!ranks.Agree(ok, problem))
+  // A file that failed on some rank is incomplete: remove it.
+  out.Close();
+  if (ranks.Rank == 0)
   {
-    vtkErrorMacro(<< "Cannot write the surface: " << problem << ".");
-    this->SetErrorCode(1);
+    ::unlink(name.c_str());
   }
+  fail(problem);
 }
 
 //------------------------------------------------------------------------------

@@ -1,31 +1,48 @@
 /**
  * @class   vtkRGMergedSurfaceWriter
- * @brief   writes a surface distributed over ranks as one mesh (STL, PLY or VTP)
+ * @brief   writes a surface distributed over ranks as one mesh (STL, PLY, VTP) or as pieces (PVTP)
  *
- * ParaView's writers gather the pieces of a distributed surface and append them: the vertices
- * on the partition seams are written once per rank that has them. This writer gathers the
- * pieces on the first rank and merges the points that share a global point id (the
- * GlobalPointIds of vtkRGSeamRepair, or the VertexKey of vtkRGMarchingCubes) before writing, so
- * the file holds one mesh: no duplicate vertices in PLY and VTP, and shared, identical vertices
- * in STL. Without global point ids the pieces are written as they are.
+ * Problem: ParaView's writers gather the pieces of a distributed surface to one rank and append
+ * them, so the vertices on the partition seams are written once per rank that has them, and a
+ * surface of tens of millions of triangles no longer fits the gather (more than 2^31 bytes).
  *
- * The format follows the file name's extension: .stl (vtkSTLWriter), .ply (vtkPLYWriter) or
- * .vtp (vtkXMLPolyDataWriter, inline data: Debian 12's expat cannot read appended data back).
- * FileType chooses binary (default) or ASCII.
+ * Approach: nothing is gathered. The surface is first numbered as one mesh (the GlobalPointIds
+ * and duplicate flags of vtkRGSeamRepair; an input without them is numbered by an internal
+ * vtkRGSeamRepair without smoothing). Every record of the file then has a place known to every
+ * rank: vertex g at the vertex section's start plus g records, the ranks' triangles one after the
+ * other (an exclusive prefix sum of their counts). Text formats use fixed-width numbers, so their
+ * records have a fixed size too. Each rank writes its own records into the one file at those
+ * byte offsets; rank 0 writes the headers. The file holds each vertex once, in global-id order,
+ * and each triangle once: the same vertices, in the same order, for any number of ranks. All
+ * counts and offsets are 64-bit.
+ *
+ * Steps (every rank makes the same collective calls):
+ * 1. Agree the file name and format; number the mesh if needed (collective).
+ * 2. Sum the owned vertex and triangle counts, and prefix-sum the triangles (collective).
+ *    Formats whose counts are 32-bit (STL's triangle count, PLY's vertex indices) give an
+ *    error before anything is written when the mesh is larger.
+ * 3. Rank 0 creates the file; the others open it once that is agreed.
+ * 4. Each rank writes its vertices (grouped in runs of consecutive ids) and its triangles;
+ *    the status of every rank is agreed, and a file that failed anywhere is removed.
+ *
+ * The format follows the file name's extension: .stl (binary or ASCII), .ply (binary or ASCII,
+ * with vertex normals when the surface has them), .vtp (VTK XML polydata with inline data,
+ * binary or ASCII: Debian 12's expat cannot read appended data back), or .pvtp (ParaView's
+ * parallel form: one .vtp piece per rank, as they are, and a .pvtp index).
+ *
+ * @warning The ranks write into one file: on a cluster, the file must be on a file system that
+ * every rank sees (or use .pvtp). Only triangle surfaces can be written.
+ *
+ * @sa vtkRGSeamRepair
  */
 
 #ifndef vtkRGMergedSurfaceWriter_h
 #define vtkRGMergedSurfaceWriter_h
 
 #include "RGMCFiltersModule.h" // For export macro
-#include "vtkSmartPointer.h"   // For Merge
 #include "vtkWriter.h"
 
-#include <vector> // For Merge
-
-class vtkDataObject;
 class vtkMultiProcessController;
-class vtkPolyData;
 
 class RGMCFILTERS_EXPORT vtkRGMergedSurfaceWriter : public vtkWriter
 {
@@ -36,7 +53,7 @@ public:
 
   ///@{
   /**
-   * The file to write; its extension (.stl, .ply, .vtp) chooses the format.
+   * The file to write; its extension (.stl, .ply, .vtp, .pvtp) chooses the format.
    */
   vtkSetStringMacro(FileName);
   vtkGetStringMacro(FileName);
@@ -57,12 +74,6 @@ public:
   void SetController(vtkMultiProcessController*);
   vtkGetObjectMacro(Controller, vtkMultiProcessController);
   ///@}
-
-  /**
-   * The pieces of all ranks appended, with the points that share a global id merged: what
-   * this writer writes (exposed for tests).
-   */
-  static vtkSmartPointer<vtkPolyData> Merge(const std::vector<vtkSmartPointer<vtkDataObject>>& pieces);
 
 protected:
   vtkRGMergedSurfaceWriter();

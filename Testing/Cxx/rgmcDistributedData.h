@@ -141,6 +141,15 @@ inline Run Extract(vtkMultiProcessController* controller, vtkImageData* image, d
   return r;
 }
 
+/// True when `text` is the same on every rank.
+inline bool SameOnAllRanks(vtkMultiProcessController* controller, const std::string& text)
+{
+  long long h = static_cast<long long>(std::hash<std::string>()(text) >> 1), lo = 0, hi = 0;
+  controller->AllReduce(&h, &lo, 1, vtkCommunicator::MIN_OP);
+  controller->AllReduce(&h, &hi, 1, vtkCommunicator::MAX_OP);
+  return lo == hi;
+}
+
 } // namespace rgmc_test
 
 #endif

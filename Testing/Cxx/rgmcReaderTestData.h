@@ -4,6 +4,7 @@
 #ifndef rgmcReaderTestData_h
 #define rgmcReaderTestData_h
 
+#include "rgmcDistributedData.h" // SameOnAllRanks
 #include "rgmcTestData.h"
 
 #include "vtkAlgorithm.h"
@@ -146,15 +147,6 @@ inline std::string ReaderMessage(const std::string& errors)
   }
   const std::size_t end = errors.find('\n', at);
   return errors.substr(at + 3, end == std::string::npos ? std::string::npos : end - at - 3);
-}
-
-/// True when `text` is the same on every rank.
-inline bool SameOnAllRanks(vtkMultiProcessController* controller, const std::string& text)
-{
-  long long h = static_cast<long long>(std::hash<std::string>()(text) >> 1), lo = 0, hi = 0;
-  controller->AllReduce(&h, &lo, 1, vtkCommunicator::MIN_OP);
-  controller->AllReduce(&h, &hi, 1, vtkCommunicator::MAX_OP);
-  return lo == hi;
 }
 
 /// Checks that reading failed on this rank with a message holding every one of `texts`, the

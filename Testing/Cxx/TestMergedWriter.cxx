@@ -1,0 +1,350 @@
+// vtkRGMergedSurfaceWriter on 1 rank (vtkDummyController) and under mpiexec: the phantom's
+// skull, extracted and repaired on this many ranks, written as one file in every format (STL,
+// PLY and VTP, binary and ASCII) with nothing gathered, then read back on rank 0 by VTK's own
+// readers and compared with the 1-rank mesh: the same vertices to the bit, in the same
+// (global-id) order, the same normals, the same triangles counted with multiplicity, for any
+// rank count and decomposition. A surface that is not numbered yet (the extraction's output) is
+// numbered by the writer. PVTP writes one piece per rank. Errors: a directory that does not
+// exist, an unknown extension, and a disk that fills up on one rank only (a file size limit on
+// that rank) give the same error on every rank, without a hang, and leave no file behind.
+#include "rgmcDistributedData.h"
+#include "rgmcTestController.h"
+#include "rgmcTestData.h"
+
+#include "vtkCellArray.h"
+#include "vtkDataArray.h"
+#include "vtkDummyController.h"
+#include "vtkIdList.h"
+#include "vtkPLYReader.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkRGMergedSurfaceWriter.h"
+#include "vtkRGPhantomSource.h"
+#include "vtkRGSeamRepair.h"
+#include "vtkSTLReader.h"
+#include "vtkXMLPPolyDataReader.h"
+#include "vtkXMLPolyDataReader.h"
+
+#include <algorithm>
+#include <array>
+#include <csignal>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+using namespace rgmc_test;
+
+namespace
+{
+
+const int Whole[6] = { 0, 48, 0, 48, 0, 48 };
+
+vtkSmartPointer<vtkImageData> Skull(const int extent[6])
+{
+  vtkNew<vtkRGPhantomSource> phantom;
+  phantom->SetDimensions(49, 49, 49);
+  phantom->UpdateExtent(const_cast<int*>(extent));
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->DeepCopy(phantom->GetOutput());
+  image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
+  return image;
+}
+
+vtkSmartPointer<vtkPolyData> Repair(vtkMultiProcessController* controller, vtkPolyData* input)
+{
+  vtkNew<vtkRGSeamRepair> repair;
+  repair->SetController(controller);
+  repair->SetInputData(input);
+  repair->SetSmoothingMethod(vtkRGSeamRepair::LAPLACIAN); // smoothed: with normals
+  repair->Update();
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->ShallowCopy(repair->GetOutput());
+  return out;
+}
+
+struct Written
+{
+  bool Ok = false;
+  std::string Errors;
+};
+
+Written Write(vtkMultiProcessController* controller, vtkPolyData* surface, const std::string& path,
+  int type)
+{
+  vtkNew<vtkRGMergedSurfaceWriter> writer;
+  vtkNew<MessageCatcher> catcher;
+  catcher->Watch(writer);
+  writer->SetController(controller);
+  writer->SetInputData(surface);
+  writer->SetFileName(path.c_str());
+  writer->SetFileType(type);
+  writer->Write();
+  return Written{ writer->GetErrorCode() == 0, catcher->Errors };
+}
+
+using Triangle = std::array<std::array<float, 3>, 3>;
+
+/// A triangle as its three corners, rotated so that the smallest comes first (orientation kept).
+Triangle Canonical(Triangle t)
+{
+  const int first = static_cast<int>(std::min_element(t.begin(), t.end()) - t.begin());
+  std::rotate(t.begin(), t.begin() + first, t.end());
+  return t;
+}
+
+/// The triangles of `pd` with their multiplicity.
+std::map<Triangle, int> Triangles(vtkPolyData* pd)
+{
+  std::map<Triangle, int> triangles;
+  vtkNew<vtkIdList> cell;
+  vtkCellArray* polys = pd->GetPolys();
+  for (vtkIdType c = 0; c < polys->GetNumberOfCells(); ++c)
+  {
+    polys->GetCellAtId(c, cell);
+    Triangle t{};
+    for (int v = 0; v < 3 && cell->GetNumberOfIds() == 3; ++v)
+    {
+      double x[3];
+      pd->GetPoint(cell->GetId(v), x);
+      t[v] = { static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2]) };
+    }
+    ++triangles[Canonical(t)];
+  }
+  return triangles;
+}
+
+/// Compares a file read back with the 1-rank mesh: points in the same order, to the bit (unless
+/// `pointsInOrder` is false: STL has no vertex list), normals, triangles with multiplicity.
+void Compare(vtkPolyData* read, vtkPolyData* reference, bool pointsInOrder, bool normals,
+  const std::string& what)
+{
+  if (pointsInOrder)
+  {
+    RGMC_CHECK(read->GetNumberOfPoints() == reference->GetNumberOfPoints(),
+      what << ": " << read->GetNumberOfPoints() << " vertices, the 1-rank mesh has "
+           << reference->GetNumberOfPoints());
+    vtkIdType differ = 0, normalsDiffer = 0;
+    vtkDataArray* readNormals = read->GetPointData()->GetNormals();
+    vtkDataArray* referenceNormals = reference->GetPointData()->GetNormals();
+    RGMC_CHECK(!normals || (readNormals && referenceNormals), what << ": no normals");
+    for (vtkIdType p = 0; p < std::min(read->GetNumberOfPoints(), reference->GetNumberOfPoints());
+         ++p)
+    {
+      double a[3], b[3];
+      read->GetPoint(p, a);
+      reference->GetPoint(p, b);
+      differ += static_cast<float>(a[0]) != static_cast<float>(b[0]) ||
+        static_cast<float>(a[1]) != static_cast<float>(b[1]) ||
+        static_cast<float>(a[2]) != static_cast<float>(b[2]);
+      if (normals && readNormals && referenceNormals)
+      {
+        readNormals->GetTuple(p, a);
+        referenceNormals->GetTuple(p, b);
+        normalsDiffer += static_cast<float>(a[0]) != static_cast<float>(b[0]) ||
+          static_cast<float>(a[1]) != static_cast<float>(b[1]) ||
+          static_cast<float>(a[2]) != static_cast<float>(b[2]);
+      }
+    }
+    RGMC_CHECK(differ == 0, what << ": " << differ << " vertices differ from the 1-rank mesh's");
+    RGMC_CHECK(
+      normalsDiffer == 0, what << ": " << normalsDiffer << " normals differ from the 1-rank mesh's");
+  }
+  RGMC_CHECK(read->GetNumberOfPolys() == reference->GetNumberOfPolys(),
+    what << ": " << read->GetNumberOfPolys() << " triangles, the 1-rank mesh has "
+         << reference->GetNumberOfPolys());
+  RGMC_CHECK(Triangles(read) == Triangles(reference),
+    what << ": the triangles (with multiplicity) differ from the 1-rank mesh's");
+}
+
+vtkSmartPointer<vtkPolyData> Read(const std::string& path)
+{
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  const std::string extension = path.substr(path.find_last_of('.') + 1);
+  if (extension == "ply")
+  {
+    vtkNew<vtkPLYReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    out->ShallowCopy(reader->GetOutput());
+  }
+  else if (extension == "stl")
+  {
+    vtkNew<vtkSTLReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->MergingOff();
+    reader->Update();
+    out->ShallowCopy(reader->GetOutput());
+  }
+  else
+  {
+    vtkNew<vtkXMLPolyDataReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    out->ShallowCopy(reader->GetOutput());
+  }
+  return out;
+}
+
+/// The writer's own message: its first error line without the "vtkClass (0x...): " prefix,
+/// which differs between processes.
+std::string Message(const std::string& errors)
+{
+  const std::size_t at = errors.find("): ");
+  if (at == std::string::npos)
+  {
+    return errors;
+  }
+  const std::size_t end = errors.find('\n', at);
+  return errors.substr(at + 3, end == std::string::npos ? std::string::npos : end - at - 3);
+}
+
+bool Exists(const std::string& path)
+{
+  struct stat s;
+  return ::stat(path.c_str(), &s) == 0;
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  vtkNew<vtkDummyController> single;
+  const std::string dir = "TestMergedWriter-" + std::to_string(ranks);
+  if (rank == 0)
+  {
+    ::mkdir(dir.c_str(), 0755);
+  }
+  controller->Barrier();
+  const Seeds seeds = { { 0, 0, 105 } };
+
+  // The 1-rank meshes: repaired and smoothed (with normals), and only numbered (no smoothing).
+  vtkSmartPointer<vtkPolyData> reference, unsmoothed;
+  if (rank == 0)
+  {
+    vtkSmartPointer<vtkImageData> whole = Skull(Whole);
+    vtkSmartPointer<vtkPolyData> extracted =
+      Extract(single, whole, 400, vtkRGMarchingCubes::SEEDED, seeds).Output;
+    reference = Repair(single, extracted);
+    vtkNew<vtkRGSeamRepair> numbering;
+    numbering->SetController(single);
+    numbering->SetInputData(extracted);
+    numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
+    numbering->Update();
+    unsmoothed = vtkSmartPointer<vtkPolyData>::New();
+    unsmoothed->ShallowCopy(numbering->GetOutput());
+    std::cout << "1-rank skull: " << reference->GetNumberOfPoints() << " vertices, "
+              << reference->GetNumberOfPolys() << " triangles\n";
+  }
+
+  const char* formats[] = { "stl", "ply", "vtp" };
+  for (const std::string how : { "block", "slab-z", "empty-rank" })
+  {
+    if (ranks == 1 && how != "block")
+    {
+      continue;
+    }
+    vtkSmartPointer<vtkImageData> image = MakePiece(Skull, Whole, PieceOf(how, Whole, rank, ranks));
+    vtkSmartPointer<vtkPolyData> extracted =
+      Extract(controller, image, 400, vtkRGMarchingCubes::SEEDED, seeds).Output;
+    vtkSmartPointer<vtkPolyData> repaired = Repair(controller, extracted);
+    for (const char* format : formats)
+    {
+      for (int type : { VTK_BINARY, VTK_ASCII })
+      {
+        std::ostringstream what;
+        what << format << (type == VTK_BINARY ? " binary" : " ASCII") << ", " << how << " on "
+             << ranks << " ranks";
+        const std::string path = dir + "/skull-" + how + "-" + std::to_string(type) + "." + format;
+        const Written w = Write(controller, repaired, path, type);
+        RGMC_CHECK(w.Ok && w.Errors.empty(), what.str() << ": " << w.Errors);
+        if (rank == 0)
+        {
+          const bool stl = std::string(format) == "stl";
+          Compare(Read(path), reference, !stl, !stl, what.str());
+        }
+      }
+    }
+    // Not numbered yet: the writer numbers it (by Seam Repair's rule) and writes the same mesh.
+    {
+      const std::string path = dir + "/unnumbered-" + how + ".ply";
+      const Written w = Write(controller, extracted, path, VTK_BINARY);
+      RGMC_CHECK(w.Ok && w.Errors.empty(), "unnumbered, " << how << ": " << w.Errors);
+      if (rank == 0)
+      {
+        Compare(Read(path), unsmoothed, true, false, "unnumbered PLY, " + how);
+      }
+    }
+  }
+
+  // PVTP: one piece per rank, as they are.
+  {
+    vtkSmartPointer<vtkImageData> image =
+      MakePiece(Skull, Whole, PieceOf("block", Whole, rank, ranks));
+    vtkSmartPointer<vtkPolyData> repaired = Repair(controller,
+      Extract(controller, image, 400, vtkRGMarchingCubes::SEEDED, seeds).Output);
+    const std::string path = dir + "/skull.pvtp";
+    const Written w = Write(controller, repaired, path, VTK_BINARY);
+    RGMC_CHECK(w.Ok && w.Errors.empty(), "pvtp: " << w.Errors);
+    if (rank == 0)
+    {
+      vtkNew<vtkXMLPPolyDataReader> reader;
+      reader->SetFileName(path.c_str());
+      reader->Update();
+      RGMC_CHECK(reader->GetOutput()->GetNumberOfPolys() == reference->GetNumberOfPolys(),
+        "pvtp: " << reader->GetOutput()->GetNumberOfPolys() << " triangles in its pieces, not "
+                 << reference->GetNumberOfPolys());
+    }
+
+    // Errors, the same on every rank, and no file left behind.
+    auto expectError = [&](const std::string& file, const std::string& text, const std::string& what) {
+      const Written e = Write(controller, repaired, file, VTK_BINARY);
+      RGMC_CHECK(!e.Ok, what << ": no error");
+      RGMC_CHECK(e.Errors.find(text) != std::string::npos,
+        what << " (rank " << rank << "): the error does not say \"" << text << "\": " << e.Errors);
+      RGMC_CHECK(
+        SameOnAllRanks(controller, Message(e.Errors)), what << ": the ranks' messages differ");
+    };
+    expectError(dir + "/no-such-directory/skull.stl", "cannot create", "a missing directory");
+    expectError(dir + "/skull.obj", "must end in .stl, .ply, .vtp or .pvtp", "an unknown extension");
+
+    // The last rank's disk is full: a file size limit below its records (its writes fail with
+    // EFBIG instead of the signal, which the test ignores).
+    const std::string full = dir + "/full.ply";
+    struct rlimit saved;
+    ::getrlimit(RLIMIT_FSIZE, &saved);
+    void (*previous)(int) = std::signal(SIGXFSZ, SIG_IGN);
+    if (rank == ranks - 1)
+    {
+      struct rlimit small = saved;
+      small.rlim_cur = 512;
+      ::setrlimit(RLIMIT_FSIZE, &small);
+    }
+    const Written e = Write(controller, repaired, full, VTK_BINARY);
+    if (rank == ranks - 1)
+    {
+      ::setrlimit(RLIMIT_FSIZE, &saved);
+    }
+    std::signal(SIGXFSZ, previous);
+    RGMC_CHECK(!e.Ok, "a full disk on rank " << ranks - 1 << ": no error");
+    RGMC_CHECK(e.Errors.find("cannot write") != std::string::npos &&
+        e.Errors.find("File too large") != std::string::npos,
+      "a full disk (rank " << rank << "): the error does not name it: " << e.Errors);
+    RGMC_CHECK(SameOnAllRanks(controller, Message(e.Errors)), "a full disk: the ranks' messages differ");
+    controller->Barrier();
+    RGMC_CHECK(!Exists(full), "a full disk: the incomplete file is still there");
+  }
+
+  long long failures = rgmc_test::Failures(), total = 0;
+  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
+  if (rank == 0)
+  {
+    std::cout << "TestMergedWriter on " << ranks << " ranks: " << total << " failed checks\n";
+  }
+  controller->Finalize();
+  return total == 0 ? 0 : 1;
+}
