@@ -85,7 +85,7 @@ def main():
     for ranks in [int(r) for r in args.ranks.split(",")]:
         output = os.path.join(args.workdir, "client-server-%d.json" % ranks)
         with pvserver(args, ranks, os.path.join(args.workdir, "pvserver-%d.log" % ranks)) as port:
-            result = run([args.pvpython, summary_script, "--connect", "localhost:%d" % port,
+            result = run([args.pvpython, summary_script, "--connect", "127.0.0.1:%d" % port,
                           "--plugin", args.plugin, "--output", output])
         if result.returncode != 0 or not os.path.exists(output):
             failures.append("the client of a %d-rank pvserver failed (status %d)" % (ranks, result.returncode))
@@ -96,7 +96,7 @@ def main():
     # A server that cannot load the plugin: the pipeline command says so, writes nothing.
     bad = os.path.join(args.workdir, "no-plugin", "skull")
     with pvserver(args, 2, os.path.join(args.workdir, "pvserver-no-plugin.log")) as port:
-        result = run([args.pvpython, args.pipeline, "--connect", "localhost:%d" % port, "--plugin", args.plugin,
+        result = run([args.pvpython, args.pipeline, "--connect", "127.0.0.1:%d" % port, "--plugin", args.plugin,
                       "--server-plugin", "/nonexistent/RGMarchingCubes.so", "--input", "phantom:32",
                       "--isovalue", "400", "--seed", "0,0,105", "--output", bad])
     if result.returncode != 2 or "the server cannot load the RGMC plugin from /nonexistent" not in result.stderr:
@@ -106,7 +106,7 @@ def main():
 
     # A non-image input: VTK's message, on the client, naming the type the filter needs.
     with pvserver(args, 2, os.path.join(args.workdir, "pvserver-non-image.log")) as port:
-        result = run([args.pvpython, os.path.join(HERE, "NonImageClient.py"), "localhost", str(port), args.plugin])
+        result = run([args.pvpython, os.path.join(HERE, "NonImageClient.py"), "127.0.0.1", str(port), args.plugin])
     text = result.stdout + result.stderr
     if "is of type vtkPolyData, but a vtkImageData is required" not in text or \
             "triangles from a sphere's polydata: 0" not in text:
