@@ -113,16 +113,7 @@ std::vector<Field> Fields()
   // The CT phantom (int16 HU, spacing and origin): skull, mandible and vertebrae.
   fields.push_back(
     Field{ "phantom", 400.0, { { { 0, 0, 105 } }, { { 0, 65, -75 }, { 0, -20, -96 } } },
-      [](const int extent[6])
-      {
-        vtkNew<vtkRGPhantomSource> phantom;
-        phantom->SetDimensions(N, N, N);
-        phantom->UpdateExtent(const_cast<int*>(extent));
-        auto image = vtkSmartPointer<vtkImageData>::New();
-        image->DeepCopy(phantom->GetOutput());
-        image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
-        return image;
-      } });
+      [](const int extent[6]) { return PhantomPiece(extent, N); } });
   return fields;
 }
 
@@ -394,13 +385,5 @@ int main(int argc, char* argv[])
     CollectiveErrors(controller);
   }
 
-  long long failures = rgmc_test::Failures(), total = 0;
-  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
-  if (rank == 0)
-  {
-    std::cout << "TestDistributed on " << ranks << " ranks: " << runs << " runs compared, " << total
-              << " failed checks\n";
-  }
-  controller->Finalize();
-  return total == 0 ? 0 : 1;
+  return rgmc_test::Finish(controller, "TestDistributed", std::to_string(runs) + " runs compared, ");
 }

@@ -44,13 +44,7 @@ const int Whole[6] = { 0, 48, 0, 48, 0, 48 };
 
 vtkSmartPointer<vtkImageData> Skull(const int extent[6])
 {
-  vtkNew<vtkRGPhantomSource> phantom;
-  phantom->SetDimensions(49, 49, 49);
-  phantom->UpdateExtent(const_cast<int*>(extent));
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->DeepCopy(phantom->GetOutput());
-  image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
-  return image;
+  return PhantomPiece(extent, 49);
 }
 
 vtkSmartPointer<vtkPolyData> Repair(vtkMultiProcessController* controller, vtkPolyData* input)
@@ -339,12 +333,5 @@ int main(int argc, char* argv[])
     RGMC_CHECK(!Exists(full), "a full disk: the incomplete file is still there");
   }
 
-  long long failures = rgmc_test::Failures(), total = 0;
-  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
-  if (rank == 0)
-  {
-    std::cout << "TestMergedWriter on " << ranks << " ranks: " << total << " failed checks\n";
-  }
-  controller->Finalize();
-  return total == 0 ? 0 : 1;
+  return rgmc_test::Finish(controller, "TestMergedWriter");
 }

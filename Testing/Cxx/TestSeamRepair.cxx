@@ -82,16 +82,7 @@ std::vector<Surface> Surfaces()
     0.0, vtkRGMarchingCubes::SEEDED, { { 46.0, 32.0, 32.0 } }, 0 });
   // The phantom's skull: a shell with 5 holes (Euler characteristic 4 - 2 * 5).
   surfaces.push_back(Surface{ "skull",
-    [](const int extent[6])
-    {
-      vtkNew<vtkRGPhantomSource> phantom;
-      phantom->SetDimensions(65, 65, 65);
-      phantom->UpdateExtent(const_cast<int*>(extent));
-      auto image = vtkSmartPointer<vtkImageData>::New();
-      image->DeepCopy(phantom->GetOutput());
-      image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
-      return image;
-    },
+    [](const int extent[6]) { return PhantomPiece(extent, 65); },
     400.0, vtkRGMarchingCubes::SEEDED, { { 0, 0, 105 } }, -6 });
   return surfaces;
 }
@@ -515,12 +506,5 @@ int main(int argc, char* argv[])
   BadInput(controller);
   Abort(controller);
 
-  long long failures = rgmc_test::Failures(), total = 0;
-  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
-  if (rank == 0)
-  {
-    std::cout << "TestSeamRepair on " << ranks << " ranks: " << total << " failed checks\n";
-  }
-  controller->Finalize();
-  return total == 0 ? 0 : 1;
+  return rgmc_test::Finish(controller, "TestSeamRepair");
 }

@@ -8,6 +8,7 @@
 #include "vtkExtentTranslator.h"
 #include "vtkMultiProcessController.h"
 #include "vtkRGMarchingCubes.h"
+#include "vtkRGPhantomSource.h"
 
 namespace rgmc_test
 {
@@ -139,6 +140,19 @@ inline Run Extract(vtkMultiProcessController* controller, vtkImageData* image, d
   r.Errors = catcher->Errors;
   r.Warnings = catcher->Warnings;
   return r;
+}
+
+/// The CT phantom sampled on `points`^3 points, over `extent` only (as a pipeline piece, without
+/// the source's ghost marks).
+inline vtkSmartPointer<vtkImageData> PhantomPiece(const int extent[6], int points)
+{
+  vtkNew<vtkRGPhantomSource> phantom;
+  phantom->SetDimensions(points, points, points);
+  phantom->UpdateExtent(const_cast<int*>(extent));
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->DeepCopy(phantom->GetOutput());
+  image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
+  return image;
 }
 
 /// True when `text` is the same on every rank.

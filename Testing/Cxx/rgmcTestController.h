@@ -7,6 +7,9 @@
 #include "vtkMPIController.h"
 #include "vtkSmartPointer.h"
 
+#include "rgmcCheck.h"
+
+#include <iostream>
 #include <string>
 
 namespace rgmc_test
@@ -28,6 +31,22 @@ inline vtkSmartPointer<vtkMultiProcessController> StartController(int& argc, cha
   controller->Initialize(&argc, &argv);
   vtkMultiProcessController::SetGlobalController(controller);
   return controller;
+}
+
+/// Ends an MPI test: the failed checks summed over the ranks, said by rank 0 after `name`
+/// ("TestX on N ranks: ..." plus `detail`), the controller finalized; returns main's status.
+inline int Finish(vtkMultiProcessController* controller, const std::string& name,
+  const std::string& detail = "")
+{
+  long long failures = Failures(), total = 0;
+  controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);
+  if (controller->GetLocalProcessId() == 0)
+  {
+    std::cout << name << " on " << controller->GetNumberOfProcesses() << " ranks: " << detail
+              << total << " failed checks\n";
+  }
+  controller->Finalize();
+  return total == 0 ? 0 : 1;
 }
 
 } // namespace rgmc_test
