@@ -240,6 +240,14 @@ Parsed ParseHeader(const std::string& path, FileHeader& h, std::string& problem)
   }
   h.Encapsulated = structure.PixelDataEncapsulated;
   h.PixelBytes = structure.PixelDataLength;
+  if (!h.Encapsulated && structure.PixelDataDeclared > structure.PixelDataLength)
+  {
+    // Said before GDCM sees the file: GDCM 3.0.24 (Debian sid) no longer parses the header of a
+    // file whose pixel data is cut short.
+    problem = "is truncated: its pixel data has " + std::to_string(structure.PixelDataLength) +
+      " bytes of the " + std::to_string(structure.PixelDataDeclared) + " its header announces";
+    return Parsed::Broken;
+  }
   const bool marked = HasDicomMark(path);
   gdcm::Reader reader;
   reader.SetFileName(path.c_str());

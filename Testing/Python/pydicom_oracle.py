@@ -19,14 +19,22 @@ import warnings
 
 import numpy as np
 import pydicom
-from pydicom.pixel_data_handlers.util import apply_modality_lut
+
+try:  # pydicom 3 (Debian sid)
+    from pydicom.pixels import apply_modality_lut
+except ImportError:  # pydicom 2 (Debian 12 and 13)
+    from pydicom.pixel_data_handlers.util import apply_modality_lut
 
 # Lossless copies of one image in pydicom's test files: the JPEG-LS file holds MR_small's pixels.
 TWINS = {"MR_small_jpeg_ls_lossless.dcm": "MR_small.dcm"}
 
 
 def samples(ds):
-    """pydicom's pixels as (frames, rows, columns, samples) float64 after the modality LUT."""
+    """pydicom's pixels as (frames, rows, columns, samples) float64 after the modality LUT, in
+    the file's own colour space (as the reader gives them, and pydicom 2 did: pydicom 3 converts
+    YBR to RGB unless told not to)."""
+    if hasattr(ds, "pixel_array_options"):
+        ds.pixel_array_options(as_rgb=False)
     array = ds.pixel_array
     frames = int(ds.get("NumberOfFrames", 1) or 1)
     spp = int(ds.get("SamplesPerPixel", 1))
