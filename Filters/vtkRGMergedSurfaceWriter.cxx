@@ -397,8 +397,10 @@ public:
       case Format::STL:
         if (this->Binary)
         {
+          // Padded with NULs: STL tools print the header as a C string (admesh 0.98.5 printed
+          // the triangle count's bytes after a header padded with spaces).
           std::string header = "RGMC merged surface (binary STL)";
-          header.resize(80, ' ');
+          header.resize(80, '\0');
           char count[4];
           PutLittleEndian(count, static_cast<std::uint32_t>(this->Triangles));
           this->L.Text(header + std::string(count, 4));

@@ -22,7 +22,8 @@ def run(command, timeout=900, env=None, tail=None):
     """Runs `command`, prints it and its output (the last `tail` characters of each stream when
     given), and returns the finished process."""
     print("+ " + " ".join(command), flush=True)
-    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env)
+    result = subprocess.run(command, capture_output=True, text=True, errors="replace",
+                            timeout=timeout, env=env)
     print(result.stdout[-tail:] if tail else result.stdout)
     print(result.stderr[-tail:] if tail else result.stderr, file=sys.stderr)
     return result
