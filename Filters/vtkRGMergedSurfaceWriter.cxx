@@ -174,14 +174,20 @@ struct Layout
   }
 };
 
+bool HostIsBigEndian()
+{
+  const std::uint16_t one = 1;
+  return *reinterpret_cast<const unsigned char*>(&one) == 0;
+}
+const bool BigEndianHost = HostIsBigEndian();
+
 // Little-endian bytes whatever the host.
 template <typename T>
 char* PutLittleEndian(char* out, T value)
 {
   unsigned char bytes[sizeof(T)];
   std::memcpy(bytes, &value, sizeof(T));
-  const std::uint16_t one = 1;
-  if (*reinterpret_cast<const unsigned char*>(&one) == 0)
+  if (BigEndianHost)
   {
     std::reverse(bytes, bytes + sizeof(T));
   }
@@ -191,21 +197,21 @@ char* PutLittleEndian(char* out, T value)
 
 const char Base64Digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
-/// Base64 of `size` bytes; a multiple of 3 gives no padding, so such records concatenate into
-/// one valid stream.
-std::string Base64(const char* data, std::size_t size)
+/// Base64 of `size` bytes into `out`; returns its length. A multiple of 3 gives no padding, so
+/// such records concatenate into one valid stream.
+std::size_t Base64(const char* data, std::size_t size, char* out)
 {
-  std::string out;
+  char* start = out;
   const auto* in = reinterpret_cast<const unsigned char*>(data);
   for (std::size_t i = 0; i < size; i += 3)
   {
     const unsigned a = in[i], b = i + 1 < size ? in[i + 1] : 0, c = i + 2 < size ? in[i + 2] : 0;
-    out += Base64Digits[a >> 2];
-    out += Base64Digits[((a & 3) << 4) | (b >> 4)];
-    out += i + 1 < size ? Base64Digits[((b & 15) << 2) | (c >> 6)] : '=';
-    out += i + 2 < size ? Base64Digits[c & 63] : '=';
+    *out++ = Base64Digits[a >> 2];
+    *out++ = Base64Digits[((a & 3) << 4) | (b >> 4)];
+    *out++ = i + 1 < size ? Base64Digits[((b & 15) << 2) | (c >> 6)] : '=';
+    *out++ = i + 2 < size ? Base64Digits[c & 63] : '=';
   }
-  return out;
+  return static_cast<std::size_t>(out - start);
 }
 
 /// Text of fixed width: a number with its sign or a space, in scientific notation with all the digits its type
@@ -242,8 +248,8 @@ struct Mesh
 {
   vtkPoints* Points = nullptr;
   vtkDataArray* Normals = nullptr;              // 3 components, or none
+  vtkIdTypeArray* Ids = nullptr;                // global id of each local point
   std::vector<std::pair<Int, vtkIdType>> Owned; // (global id, local point), by global id
-  std::vector<Int> Gid;                         // global id of each local point
   std::vector<vtkIdType> Triangles;             // 3 local points each
 };
 
@@ -270,13 +276,12 @@ Collected Collect(vtkPolyData* pd, Mesh& mesh)
     {
       return Collected::NotNumbered;
     }
-    mesh.Gid.resize(static_cast<std::size_t>(n));
+    mesh.Ids = ids;
     for (vtkIdType p = 0; p < n; ++p)
     {
-      mesh.Gid[p] = ids->GetValue(p);
       if ((ghosts->GetValue(p) & vtkDataSetAttributes::DUPLICATEPOINT) == 0)
       {
-        mesh.Owned.emplace_back(mesh.Gid[p], p);
+        mesh.Owned.emplace_back(ids->GetValue(p), p);
       }
     }
     std::sort(mesh.Owned.begin(), mesh.Owned.end());
@@ -307,9 +312,9 @@ Collected Collect(vtkPolyData* pd, Mesh& mesh)
 /// owned once.
 bool Placeable(const Mesh& mesh, Int vertices)
 {
-  for (Int g : mesh.Gid)
+  for (vtkIdType p = 0; mesh.Ids && p < mesh.Ids->GetNumberOfTuples(); ++p)
   {
-    if (g < 0 || g >= vertices)
+    if (mesh.Ids->GetValue(p) < 0 || mesh.Ids->GetValue(p) >= vertices)
     {
       return false;
     }
@@ -480,12 +485,9 @@ public:
     }
     char record[RecordCapacity];
     const bool interleaved = this->Kind == Format::PLY;
-    for (const auto& owned : this->M.Owned)
+    // STL has no vertex list: its triangles carry their corners.
+    for (const auto& owned : this->Kind == Format::STL ? NoVertices : this->M.Owned)
     {
-      if (this->Kind == Format::STL)
-      {
-        break;
-      }
       double x[3];
       this->M.Points->GetPoint(owned.second, x);
       const char end = interleaved && this->WithNormals ? ' ' : '\n';
@@ -545,6 +547,7 @@ public:
 
 private:
   static constexpr std::size_t RecordCapacity = 1024;
+  static const std::vector<std::pair<Int, vtkIdType>> NoVertices;
 
   // Places a record of `length` bytes, which must be `expected`, at index `index` of `block`.
   bool Put(
@@ -574,9 +577,7 @@ private:
       }
       if (this->Kind == Format::VTP)
       {
-        const std::string text = Base64(bytes, static_cast<std::size_t>(end - bytes));
-        std::memcpy(out, text.data(), text.size());
-        return static_cast<Int>(text.size());
+        return static_cast<Int>(Base64(bytes, static_cast<std::size_t>(end - bytes), out));
       }
       std::memcpy(out, bytes, static_cast<std::size_t>(end - bytes));
       return end - bytes;
@@ -669,8 +670,11 @@ private:
       out += std::sprintf(out, "  endloop\nendfacet\n");
       return out - start;
     }
-    const Int g[3] = { sample ? 0 : this->M.Gid[local[0]], sample ? 0 : this->M.Gid[local[1]],
-      sample ? 0 : this->M.Gid[local[2]] };
+    Int g[3] = { 0, 0, 0 };
+    for (int v = 0; v < 3 && !sample; ++v)
+    {
+      g[v] = this->M.Ids->GetValue(local[v]);
+    }
     const bool wide = this->Vertices > std::numeric_limits<std::int32_t>::max();
     if (this->Kind == Format::PLY && this->Binary)
     {
@@ -690,9 +694,7 @@ private:
       {
         end = PutLittleEndian(end, static_cast<std::int64_t>(id));
       }
-      const std::string text = Base64(bytes, 24);
-      std::memcpy(out, text.data(), text.size());
-      return static_cast<Int>(text.size());
+      return static_cast<Int>(Base64(bytes, 24, out));
     }
     // Right-aligned with spaces, not zeros: VTK 9.3's PLY reader reads "010" as octal.
     return std::sprintf(out, this->Kind == Format::PLY ? "3 %*lld %*lld %*lld\n" : "%*lld %*lld %*lld\n",
@@ -719,9 +721,9 @@ private:
     text += std::string(" format=\"") + (binary ? "binary" : "ascii") + "\">\n";
     if (binary)
     {
-      char header[8];
+      char header[8], encoded[12];
       PutLittleEndian(header, static_cast<std::uint64_t>(bytes));
-      text += Base64(header, 8);
+      text.append(encoded, Base64(header, 8, encoded));
     }
     return text;
   }
@@ -736,6 +738,8 @@ private:
   Int PointLength = 0, NormalLength = 0, TriangleLength = 0, OffsetLength = 0;
   int IdWidth = 1, OffsetWidth = 1;
 };
+
+const std::vector<std::pair<Int, vtkIdType>> MergedFile::NoVertices;
 
 } // namespace
 

@@ -96,9 +96,10 @@ def number_of_ranks():
     return servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
 
 
-def mpiexec_command(ranks):
-    """mpiexec with the flags this MPI needs to run `ranks` processes on this machine."""
-    mpiexec = shutil.which("mpiexec")
+def mpiexec_command(ranks, mpiexec=None):
+    """mpiexec (the one on PATH unless given) with the flags this MPI needs to run `ranks`
+    processes on this machine."""
+    mpiexec = mpiexec or shutil.which("mpiexec")
     if not mpiexec:
         raise UsageError("--ranks %d needs mpiexec (Debian: apt-get install openmpi-bin)" % ranks)
     command = [mpiexec, "-n", str(ranks)]

@@ -1,8 +1,12 @@
 """What the Python tests share: the list of failed checks, running a command with its output
 shown in the test's log, and how to start MPI and a private X server on every Debian release."""
 
+import os
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "Scripts"))
+import rgmc_common  # noqa: E402
 
 # Xvfb resets whenever its last client disconnects; an MPI rank that connects during the reset
 # aborts with "bad X server connection". -noreset keeps the server up for the whole command.
@@ -35,8 +39,6 @@ def xvfb_run(xvfb_run_program, command):
 
 
 def mpiexec_command(mpiexec, ranks):
-    """`mpiexec -n ranks` with the flags Open MPI needs to run more ranks than cores. Open MPI 5
-    removed --oversubscribe; --map-by :OVERSUBSCRIBE works on 4 and 5."""
-    version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True).stdout
-    oversubscribe = ["--map-by", ":OVERSUBSCRIBE"] if "Open MPI" in version or "OpenRTE" in version else []
-    return [mpiexec, "-n", str(ranks)] + oversubscribe
+    """`mpiexec -n ranks` with the flags Open MPI needs to run more ranks than cores: the
+    pipeline command's own rule (Scripts/rgmc_common.py)."""
+    return rgmc_common.mpiexec_command(ranks, mpiexec)
