@@ -2,6 +2,7 @@
 #include "vtkRGCollective.h"
 
 #include <algorithm>
+#include <string>
 
 namespace rgmc
 {
@@ -13,10 +14,30 @@ Ranks::Ranks(vtkMultiProcessController* controller)
 {
 }
 
+bool Ranks::Check(int status, const char* what)
+{
+  if (status != 1 && this->Failure.empty())
+  {
+    this->Failure = std::string("communication between the ranks failed (") + what + ")";
+  }
+  return status == 1;
+}
+
 bool Ranks::Agree(bool ok, std::string& message)
 {
+  if (ok && !this->Failure.empty())
+  {
+    ok = false;
+    message = this->Failure;
+  }
+  this->Failure.clear();
   int mine = ok ? this->Size : this->Rank, first = this->Size;
-  this->C->AllReduce(&mine, &first, 1, vtkCommunicator::MIN_OP);
+  if (this->C->AllReduce(&mine, &first, 1, vtkCommunicator::MIN_OP) != 1)
+  {
+    // The agreement itself failed: nothing more can be trusted of the other ranks.
+    message = "communication between the ranks failed (agreeing on a status)";
+    return false;
+  }
   if (first == this->Size)
   {
     return true;
@@ -39,21 +60,21 @@ bool Ranks::Agree(bool ok, std::string& message)
 bool Ranks::Any(bool flag)
 {
   int mine = flag ? 1 : 0, any = 0;
-  this->C->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP);
+  this->Check(this->C->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP), "a reduction");
   return any != 0;
 }
 
 void Ranks::Broadcast(std::string& text, int root)
 {
   vtkIdType length = static_cast<vtkIdType>(text.size());
-  this->C->Broadcast(&length, 1, root);
+  this->Check(this->C->Broadcast(&length, 1, root), "a broadcast");
   if (this->Rank != root)
   {
     text.assign(static_cast<std::size_t>(length), '\0');
   }
   if (length > 0)
   {
-    this->C->Broadcast(&text[0], length, root);
+    this->Check(this->C->Broadcast(&text[0], length, root), "a broadcast");
   }
 }
 
@@ -86,21 +107,44 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
     }
     auto send = [&]()
     {
-      vtkIdType count = static_cast<vtkIdType>(outgoing[partner].size());
-      this->C->Send(&count, 1, partner, tag);
-      if (count > 0)
+      const vtkIdType count = static_cast<vtkIdType>(outgoing[partner].size());
+      this->Check(this->C->Send(&count, 1, partner, tag), "sending a message's size");
+      for (vtkIdType at = 0; at < count; at += MaxChunk)
       {
-        this->C->Send(outgoing[partner].data(), count, partner, tag + 1);
+        this->Check(this->C->Send(outgoing[partner].data() + at, std::min(MaxChunk, count - at),
+                      partner, tag + 1),
+          "sending a message");
       }
     };
     auto receive = [&]()
     {
       vtkIdType count = 0;
-      this->C->Receive(&count, 1, partner, tag);
-      incoming[partner].resize(static_cast<std::size_t>(count));
-      if (count > 0)
+      this->Check(this->C->Receive(&count, 1, partner, tag), "receiving a message's size");
+      std::vector<T>& in = incoming[partner];
+      T* target = nullptr;
+      std::vector<T> drain;
+      try
       {
-        this->C->Receive(incoming[partner].data(), count, partner, tag + 1);
+        in.resize(static_cast<std::size_t>(count));
+        target = in.data();
+      }
+      catch (const std::bad_alloc&)
+      {
+        if (this->Failure.empty())
+        {
+          this->Failure = "not enough memory to receive a message of " + std::to_string(count) +
+            " values from rank " + std::to_string(partner);
+        }
+      }
+      for (vtkIdType at = 0; at < count; at += MaxChunk)
+      {
+        const vtkIdType length = std::min(MaxChunk, count - at);
+        if (!target)
+        {
+          drain.resize(static_cast<std::size_t>(MaxChunk)); // a small, fixed buffer
+        }
+        this->Check(this->C->Receive(target ? target + at : drain.data(), length, partner, tag + 1),
+          "receiving a message");
       }
     };
     if (me < partner)

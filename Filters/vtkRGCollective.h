@@ -8,6 +8,8 @@
 #include "vtkMultiProcessController.h"
 #include "vtkType.h"
 
+#include <new>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -20,9 +22,37 @@ class Ranks
 public:
   explicit Ranks(vtkMultiProcessController* controller);
 
-  /// True when `ok` holds on every rank. Otherwise every rank gets, in `message`, the message of
-  /// the lowest failing rank.
+  /// True when `ok` holds on every rank and no communication of this rank has failed since the
+  /// last agreement. Otherwise every rank gets, in `message`, the message of the lowest failing
+  /// rank.
   bool Agree(bool ok, std::string& message);
+
+  /// Runs `work` (local work, no communication) unless `problem` is already set; an allocation
+  /// failure becomes the problem "not enough memory to <what>". Then agrees, as Agree does.
+  template <typename Work>
+  bool Step(const char* what, std::string& problem, Work&& work)
+  {
+    if (problem.empty())
+    {
+      try
+      {
+        work();
+      }
+      catch (const std::bad_alloc&)
+      {
+        problem = std::string("not enough memory to ") + what;
+      }
+      catch (const std::length_error&)
+      {
+        problem = std::string("not enough memory to ") + what;
+      }
+    }
+    return this->Agree(problem.empty(), problem);
+  }
+
+  /// Records the status of a call to the controller (1 is success): a failure is reported at the
+  /// next Agree, on every rank. Returns whether the call succeeded.
+  bool Check(int status, const char* what);
 
   /// Whether `flag` holds on some rank.
   bool Any(bool flag);
@@ -33,6 +63,9 @@ public:
   /// Sends outgoing[r] to every rank r marked in `partners` (a symmetric relation) and returns
   /// what each sent back. Rounds follow a round-robin tournament, so every round is a perfect
   /// matching and blocking sends cannot deadlock; their number depends on the rank count only.
+  /// Messages go in chunks of at most MaxChunk values (MPI counts are 32-bit). A message that
+  /// cannot be received (no memory for it) is drained and dropped, and the failure is reported at
+  /// the next Agree: the ranks never fall out of step.
   std::vector<std::vector<vtkIdType>> Exchange(const std::vector<std::vector<vtkIdType>>& outgoing,
     const std::vector<bool>& partners, int tag);
 
@@ -44,7 +77,11 @@ public:
   const int Rank;
   const int Size;
 
+  static constexpr vtkIdType MaxChunk = vtkIdType(1) << 20;
+
 private:
+  std::string Failure; // the first failed communication since the last agreement
+
   template <typename T>
   std::vector<std::vector<T>> ExchangeAny(
     const std::vector<std::vector<T>>& outgoing, const std::vector<bool>& partners, int tag);

@@ -26,16 +26,19 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkTypeInt32Array.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkAOSDataArrayTemplate.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <functional>
 #include <type_traits>
-#include <map>
+#include <array>
+#include <numeric>
+#include <queue>
 #include <sstream>
-#include <tuple>
 #include <vector>
 
 vtkStandardNewMacro(vtkRGSeamRepair);
@@ -50,13 +53,9 @@ constexpr int NumberingTag = 48800, AnswerTag = 48802, EdgesTag = 48804, Request
 
 // ---- vertex identities -----------------------------------------------------------------------
 
-/// What makes copies of a vertex one vertex: its key (A), or its exact coordinates (A, B, C).
-struct Identity
-{
-  std::uint64_t A = 0, B = 0, C = 0;
-  bool operator<(const Identity& o) const { return std::tie(A, B, C) < std::tie(o.A, o.B, o.C); }
-  bool operator==(const Identity& o) const { return A == o.A && B == o.B && C == o.C; }
-};
+/// What makes copies of a vertex one vertex: its key (one word), or its exact coordinates (three).
+template <int Words>
+using Identity = std::array<std::uint64_t, Words>;
 
 std::uint64_t Bits(double v)
 {
@@ -66,23 +65,18 @@ std::uint64_t Bits(double v)
   return b;
 }
 
-void Append(std::vector<vtkIdType>& out, const Identity& id)
+vtkIdType Word(std::uint64_t w)
 {
-  for (std::uint64_t w : { id.A, id.B, id.C })
-  {
-    vtkIdType v;
-    std::memcpy(&v, &w, sizeof v);
-    out.push_back(v);
-  }
+  vtkIdType v;
+  std::memcpy(&v, &w, sizeof v);
+  return v;
 }
 
-Identity Read(const vtkIdType* p)
+std::uint64_t Unword(vtkIdType v)
 {
-  Identity id;
-  std::memcpy(&id.A, p, 8);
-  std::memcpy(&id.B, p + 1, 8);
-  std::memcpy(&id.C, p + 2, 8);
-  return id;
+  std::uint64_t w;
+  std::memcpy(&w, &v, sizeof w);
+  return w;
 }
 
 vtkIdType PackDouble(double v)
@@ -99,197 +93,288 @@ double UnpackDouble(vtkIdType b)
   return v;
 }
 
-/// This rank's distinct vertices: sorted identities, an input point of each, and the vertex of
-/// every input point.
+/// This rank's distinct vertices. When every input point is a distinct vertex (the usual case:
+/// the extraction emits each vertex once per rank), vertex v is input point v and the maps are
+/// empty; otherwise the vertices are numbered in identity order and the maps say which points
+/// they merge.
 struct LocalVertices
 {
-  std::vector<Identity> Ids;
-  std::vector<vtkIdType> First;
-  std::vector<vtkIdType> Of;
+  vtkIdType Count = 0;
+  std::vector<vtkIdType> Sorted; // the vertices in identity order
+  std::vector<vtkIdType> Of;     // input point -> vertex (empty: the same number)
+  std::vector<vtkIdType> First;  // vertex -> its first input point (empty: the same number)
+
+  bool Merged() const { return !this->Of.empty(); }
+  vtkIdType PointOf(vtkIdType v) const { return this->First.empty() ? v : this->First[v]; }
+  vtkIdType VertexOf(vtkIdType p) const { return this->Of.empty() ? p : this->Of[p]; }
 };
 
-LocalVertices MergeLocal(vtkPolyData* input, vtkIdTypeArray* keys)
+/// Sorts the input points by identity into distinct vertices; `ids` gets the vertices'
+/// identities in sorted order.
+template <int Words>
+LocalVertices MergeLocal(
+  vtkPolyData* input, const vtkIdType* keys, std::vector<Identity<Words>>& ids)
 {
   const vtkIdType n = input->GetNumberOfPoints();
-  std::vector<std::pair<Identity, vtkIdType>> all(static_cast<std::size_t>(n));
+  std::vector<std::pair<Identity<Words>, vtkIdType>> all(static_cast<std::size_t>(n));
   for (vtkIdType p = 0; p < n; ++p)
   {
-    Identity id;
-    if (keys)
+    Identity<Words>& id = all[p].first;
+    if (Words == 1)
     {
-      id.A = static_cast<std::uint64_t>(keys->GetValue(p));
+      id[0] = Unword(keys[p]);
     }
     else
     {
       double x[3];
       input->GetPoint(p, x);
-      id.A = Bits(x[0]);
-      id.B = Bits(x[1]);
-      id.C = Bits(x[2]);
+      for (int k = 0; k < Words; ++k)
+      {
+        id[k] = Bits(x[k]);
+      }
     }
-    all[p] = { id, p };
+    all[p].second = p;
   }
   std::sort(all.begin(), all.end());
   LocalVertices local;
-  local.Of.resize(static_cast<std::size_t>(n));
+  bool duplicates = false;
+  for (std::size_t i = 1; i < all.size() && !duplicates; ++i)
+  {
+    duplicates = all[i].first == all[i - 1].first;
+  }
+  ids.reserve(all.size());
+  local.Sorted.reserve(all.size());
+  if (duplicates)
+  {
+    local.Of.resize(static_cast<std::size_t>(n));
+  }
   for (std::size_t i = 0; i < all.size(); ++i)
   {
-    if (i == 0 || !(all[i].first == all[i - 1].first))
+    if (!duplicates)
     {
-      local.Ids.push_back(all[i].first);
-      local.First.push_back(all[i].second);
+      ids.push_back(all[i].first);
+      local.Sorted.push_back(all[i].second);
+      continue;
     }
-    local.Of[all[i].second] = static_cast<vtkIdType>(local.Ids.size() - 1);
+    if (i == 0 || all[i].first != all[i - 1].first)
+    {
+      local.Sorted.push_back(static_cast<vtkIdType>(ids.size()));
+      local.First.push_back(all[i].second);
+      ids.push_back(all[i].first);
+    }
+    local.Of[all[i].second] = static_cast<vtkIdType>(ids.size()) - 1;
   }
+  local.Count = static_cast<vtkIdType>(ids.size());
   return local;
 }
 
 // ---- global numbering --------------------------------------------------------------------------
 
-/// Global id, owner and other holders of each of this rank's vertices.
+/// The global id and owner of each of this rank's vertices, and the other holders of the shared
+/// ones.
 struct Numbering
 {
-  std::vector<vtkIdType> Gid;
-  std::vector<int> Owner;
+  std::vector<vtkIdType> Gid;         // by vertex
+  enum : unsigned char
+  {
+    Alone = 0,   // no other rank holds the vertex
+    Shared = 1,  // other ranks hold it too
+    Foreign = 2, // (with Shared) another rank owns it
+  };
+  std::vector<unsigned char> Holding; // by vertex
+  // The shared vertices, in global-id order: the vertex, its owner, the other ranks that hold it.
+  std::vector<vtkIdType> SharedVertex;
+  std::vector<int> SharedOwner;
   std::vector<vtkIdType> SharerOffsets{ 0 };
-  std::vector<int> Sharers; // the other ranks that hold the vertex
+  std::vector<int> Sharers;
   vtkIdType Total = 0;
-
-  bool Shared(vtkIdType v) const { return this->SharerOffsets[v + 1] > this->SharerOffsets[v]; }
 };
 
-/// Numbers the identities of all ranks in their sorted order. Each rank sends its identities to
-/// the rank responsible for their range (ranges from sampled identities), which groups equal
-/// ones and answers with their global id, owner (lowest rank) and holders. Collective.
-Numbering Number(Ranks& ranks, const std::vector<Identity>& ids)
+/// Numbers the identities of all ranks in their sorted order: a sample sort. Each rank sends its
+/// sorted identities to the ranks responsible for their ranges (from sampled identities); those
+/// merge the sorted streams, number the distinct identities in order and answer each sender
+/// with the global id of each identity it sent (in its order), and, for identities held by
+/// several ranks, the holders (the lowest owns the vertex). Collective; false (on every rank,
+/// with `problem`) on failure.
+template <int Words>
+bool Number(Ranks& ranks, const LocalVertices& local, std::vector<Identity<Words>>& ids,
+  Numbering& numbering, std::string& problem)
 {
   const int P = ranks.Size;
+  const std::size_t n = ids.size();
   // Ranges of about equal size, from up to 64 sampled identities per rank.
   std::vector<vtkIdType> samples;
-  const std::size_t n = ids.size(), k = std::min<std::size_t>(n, 64);
-  for (std::size_t i = 0; i < k; ++i)
+  for (std::size_t i = 0, k = std::min<std::size_t>(n, 64); i < k; ++i)
   {
-    Append(samples, ids[i * n / k]);
+    for (std::uint64_t w : ids[i * n / k])
+    {
+      samples.push_back(Word(w));
+    }
   }
   vtkIdType count = static_cast<vtkIdType>(samples.size());
   std::vector<vtkIdType> counts(P), offsets(P + 1, 0);
-  ranks.C->AllGather(&count, counts.data(), 1);
+  ranks.Check(ranks.C->AllGather(&count, counts.data(), 1), "gathering sample counts");
   for (int r = 0; r < P; ++r)
   {
     offsets[r + 1] = offsets[r] + counts[r];
   }
   std::vector<vtkIdType> allSamples(static_cast<std::size_t>(offsets[P]) + 1);
-  ranks.C->AllGatherV(samples.data(), allSamples.data(), count, counts.data(), offsets.data());
-  std::vector<Identity> sorted;
-  for (vtkIdType s = 0; s + 2 < offsets[P]; s += 3)
-  {
-    sorted.push_back(Read(&allSamples[s]));
-  }
-  std::sort(sorted.begin(), sorted.end());
-  std::vector<Identity> splitters;
-  for (int h = 1; h < P && !sorted.empty(); ++h)
-  {
-    splitters.push_back(sorted[h * sorted.size() / P]);
-  }
-  auto home = [&splitters](const Identity& id) {
-    return static_cast<int>(std::upper_bound(splitters.begin(), splitters.end(), id) - splitters.begin());
-  };
-
-  // Identities to their ranges' ranks (in order: the ranges follow the sorted identities).
+  ranks.Check(
+    ranks.C->AllGatherV(samples.data(), allSamples.data(), count, counts.data(), offsets.data()),
+    "gathering samples");
+  std::vector<Identity<Words>> splitters;
+  std::vector<std::size_t> sliceStart(P + 1, n);
   std::vector<std::vector<vtkIdType>> outgoing(P);
-  for (const Identity& id : ids)
+  if (!ranks.Step("send the vertex identities", problem, [&]() {
+        std::vector<Identity<Words>> sorted(static_cast<std::size_t>(offsets[P] / Words));
+        for (std::size_t s = 0; s < sorted.size(); ++s)
+        {
+          for (int k = 0; k < Words; ++k)
+          {
+            sorted[s][k] = Unword(allSamples[Words * s + k]);
+          }
+        }
+        std::sort(sorted.begin(), sorted.end());
+        for (int h = 1; h < P && !sorted.empty(); ++h)
+        {
+          splitters.push_back(sorted[h * sorted.size() / P]);
+        }
+        // The ranges follow the sorted identities: rank h gets one slice of them.
+        sliceStart[0] = 0;
+        for (int h = 1; h <= P; ++h)
+        {
+          sliceStart[h] = h - 1 < static_cast<int>(splitters.size())
+            ? static_cast<std::size_t>(
+                std::upper_bound(ids.begin(), ids.end(), splitters[h - 1]) - ids.begin())
+            : n;
+        }
+        for (int h = 0; h < P; ++h)
+        {
+          outgoing[h].reserve(Words * (sliceStart[h + 1] - sliceStart[h]));
+          for (std::size_t i = sliceStart[h]; i < sliceStart[h + 1]; ++i)
+          {
+            for (std::uint64_t w : ids[i])
+            {
+              outgoing[h].push_back(Word(w));
+            }
+          }
+        }
+        std::vector<Identity<Words>>().swap(ids); // no longer needed
+      }))
   {
-    Append(outgoing[home(id)], id);
+    return false;
   }
   const std::vector<bool> everyone(P, true);
-  const auto incoming = ranks.Exchange(outgoing, everyone, NumberingTag);
+  auto incoming = ranks.Exchange(outgoing, everyone, NumberingTag);
+  std::vector<std::vector<vtkIdType>>().swap(outgoing);
 
-  // Group equal identities; number them in order.
-  struct Entry
-  {
-    Identity Id;
-    int Source;
-    vtkIdType Position;
-  };
-  std::vector<Entry> entries;
-  for (int s = 0; s < P; ++s)
-  {
-    for (vtkIdType i = 0; i + 2 < static_cast<vtkIdType>(incoming[s].size()); i += 3)
-    {
-      entries.push_back(Entry{ Read(&incoming[s][i]), s, i / 3 });
-    }
-  }
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return a.Id < b.Id || (a.Id == b.Id && a.Source < b.Source);
-  });
-  std::vector<vtkIdType> groupOf(entries.size());
+  // Merge the ranks' sorted streams; number the distinct identities in order. Each answer holds
+  // the group number of every identity received (made a global id below), then, for the
+  // identities held by several ranks, (position, number of holders, holders...).
+  std::vector<std::vector<vtkIdType>> answers(P);
   vtkIdType groups = 0;
-  for (std::size_t e = 0; e < entries.size(); ++e)
+  if (!ranks.Step("number the vertex identities", problem, [&]() {
+        using Head = std::pair<Identity<Words>, int>; // identity, source
+        std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
+        std::vector<std::size_t> next(P, 0);
+        auto push = [&](int s) {
+          const std::vector<vtkIdType>& in = incoming[s];
+          if (next[s] + Words <= in.size())
+          {
+            Identity<Words> id;
+            for (int k = 0; k < Words; ++k)
+            {
+              id[k] = Unword(in[next[s] + k]);
+            }
+            heads.emplace(id, s);
+          }
+        };
+        for (int s = 0; s < P; ++s)
+        {
+          answers[s].reserve(incoming[s].size() / Words);
+          push(s);
+        }
+        std::vector<std::vector<vtkIdType>> sharedRecords(P);
+        std::vector<int> holders; // sources of the current group, in increasing order
+        while (!heads.empty())
+        {
+          const Identity<Words> id = heads.top().first;
+          holders.clear();
+          while (!heads.empty() && heads.top().first == id)
+          {
+            const int s = heads.top().second;
+            heads.pop();
+            holders.push_back(s);
+            answers[s].push_back(groups);
+            next[s] += Words;
+            push(s);
+          }
+          if (holders.size() > 1)
+          {
+            for (int s : holders)
+            {
+              std::vector<vtkIdType>& out = sharedRecords[s];
+              out.insert(out.end(), { static_cast<vtkIdType>(next[s] / Words - 1),
+                                      static_cast<vtkIdType>(holders.size()) });
+              out.insert(out.end(), holders.begin(), holders.end());
+            }
+          }
+          ++groups;
+        }
+        std::vector<std::vector<vtkIdType>>().swap(incoming);
+        for (int s = 0; s < P; ++s)
+        {
+          answers[s].insert(answers[s].end(), sharedRecords[s].begin(), sharedRecords[s].end());
+        }
+      }))
   {
-    if (e > 0 && !(entries[e].Id == entries[e - 1].Id))
-    {
-      ++groups;
-    }
-    groupOf[e] = groups;
+    return false;
   }
-  const vtkIdType unique = entries.empty() ? 0 : groups + 1;
-  std::vector<vtkIdType> uniques(P), first(P + 1, 0);
-  ranks.C->AllGather(&unique, uniques.data(), 1);
+  std::vector<vtkIdType> groupCounts(P), first(P + 1, 0);
+  ranks.Check(ranks.C->AllGather(&groups, groupCounts.data(), 1), "gathering vertex counts");
   for (int r = 0; r < P; ++r)
   {
-    first[r + 1] = first[r] + uniques[r];
+    first[r + 1] = first[r] + groupCounts[r];
   }
-
-  // Answers, per source in the order it sent: gid, owner, holders.
-  std::vector<std::vector<vtkIdType>> answers(P);
-  for (std::size_t e = 0; e < entries.size();)
-  {
-    std::size_t end = e;
-    while (end < entries.size() && groupOf[end] == groupOf[e])
+  // The group numbers become global ids at the senders (an answer starts with one number per
+  // identity the sender sent here).
+  auto replies = ranks.Exchange(answers, everyone, AnswerTag);
+  std::vector<std::vector<vtkIdType>>().swap(answers);
+  return ranks.Step("number the vertices", problem, [&]() {
+    numbering.Total = first[P];
+    numbering.Gid.resize(static_cast<std::size_t>(local.Count));
+    numbering.Holding.assign(static_cast<std::size_t>(local.Count), Numbering::Alone);
+    for (int h = 0; h < P; ++h)
     {
-      ++end;
-    }
-    for (std::size_t m = e; m < end; ++m)
-    {
-      std::vector<vtkIdType>& out = answers[entries[m].Source];
-      out.push_back(first[ranks.Rank] + groupOf[e]);
-      out.push_back(entries[e].Source); // the lowest holder owns the vertex
-      out.push_back(static_cast<vtkIdType>(end - e));
-      for (std::size_t h = e; h < end; ++h)
+      const std::vector<vtkIdType>& in = replies[h];
+      const std::size_t sent = sliceStart[h + 1] - sliceStart[h];
+      for (std::size_t i = 0; i < sent; ++i)
       {
-        out.push_back(entries[h].Source);
+        numbering.Gid[local.Sorted[sliceStart[h] + i]] = first[h] + in[i];
       }
-    }
-    e = end;
-  }
-  // Each source's entries come in its own order, since its identities were sorted.
-  const auto replies = ranks.Exchange(answers, everyone, AnswerTag);
-
-  Numbering numbering;
-  numbering.Total = first[P];
-  numbering.Gid.reserve(n);
-  numbering.Owner.reserve(n);
-  for (int h = 0; h < P; ++h)
-  {
-    const std::vector<vtkIdType>& in = replies[h];
-    for (std::size_t i = 0; i < in.size();)
-    {
-      numbering.Gid.push_back(in[i]);
-      numbering.Owner.push_back(static_cast<int>(in[i + 1]));
-      const vtkIdType holders = in[i + 2];
-      for (vtkIdType j = 0; j < holders; ++j)
+      // Shared identities, in increasing position: the shared vertices come in gid order.
+      for (std::size_t i = sent; i + 1 < in.size();)
       {
-        const int holder = static_cast<int>(in[i + 3 + j]);
-        if (holder != ranks.Rank)
+        const vtkIdType v = local.Sorted[sliceStart[h] + static_cast<std::size_t>(in[i])];
+        const vtkIdType holders = in[i + 1];
+        const int owner = static_cast<int>(in[i + 2]);
+        numbering.SharedVertex.push_back(v);
+        numbering.SharedOwner.push_back(owner);
+        numbering.Holding[v] =
+          owner != ranks.Rank ? Numbering::Shared | Numbering::Foreign : Numbering::Shared;
+        for (vtkIdType j = 0; j < holders; ++j)
         {
-          numbering.Sharers.push_back(holder);
+          const int holder = static_cast<int>(in[i + 2 + j]);
+          if (holder != ranks.Rank)
+          {
+            numbering.Sharers.push_back(holder);
+          }
         }
+        numbering.SharerOffsets.push_back(static_cast<vtkIdType>(numbering.Sharers.size()));
+        i += 2 + static_cast<std::size_t>(holders);
       }
-      numbering.SharerOffsets.push_back(static_cast<vtkIdType>(numbering.Sharers.size()));
-      i += 3 + static_cast<std::size_t>(holders);
     }
-  }
-  return numbering;
+  });
 }
 
 // ---- the mesh around each owned vertex ---------------------------------------------------------
@@ -329,15 +414,15 @@ struct BorderTest
   }
 };
 
-/// A neighbour of an owned vertex, on the whole mesh.
+/// A neighbour of a vertex, on the whole mesh: an edge at the vertex.
 struct Neighbour
 {
   vtkIdType Gid;
-  int Uses;
+  int Uses;        // triangles on the edge
   vtkIdType Local; // index into this rank's vertices, or -1
   int Provider;    // a rank that holds it, when not local
-  int Mask;
-  double X[3];
+  int Mask;        // when not local: the volume faces it lies on
+  double X[3];     // when not local: its position
 };
 
 struct Checks
@@ -345,53 +430,31 @@ struct Checks
   vtkIdType Edges = 0, Boundary = 0, Border = 0, NonManifold = 0;
 };
 
-template <typename T>
+/// The repair of one rank's piece, with points of type T and triangles over vertex indices of
+/// type I (the input's own connectivity when its points need no merging).
+template <typename T, typename I>
 class Repair
 {
 public:
-  Repair(Ranks& ranks, vtkPolyData* input, const LocalVertices& local, const Numbering& numbering,
-    const BorderTest& border)
+  Repair(Ranks& ranks, const LocalVertices& local, const Numbering& numbering,
+    const BorderTest& border, const vtkIdType* keys, const T* x, const I* triangles,
+    vtkIdType numTriangles)
     : R(ranks)
-    , Input(input)
     , Local(local)
     , Num(numbering)
     , Border(border)
-    , N(static_cast<vtkIdType>(local.Ids.size()))
-    , Index(2 * local.Ids.size() + 16)
+    , Grid(border.Whole, border.Whole)
+    , Keys(keys)
+    , X(x)
+    , Triangles(triangles)
+    , NumTriangles(numTriangles)
+    , N(local.Count)
+    , ToSharer(ranks.Size)
+    , FromOwner(ranks.Size)
+    , Provide(ranks.Size)
+    , RemoteOrder(ranks.Size)
+    , RequestLists(ranks.Size)
   {
-    // Positions of the vertices, in the input's precision.
-    this->X.resize(3 * this->N);
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      double x[3];
-      input->GetPoint(local.First[v], x);
-      for (int k = 0; k < 3; ++k)
-      {
-        this->X[3 * v + k] = static_cast<T>(x[k]);
-      }
-      bool inserted;
-      this->Index.FindOrInsert(numbering.Gid[v], static_cast<std::int32_t>(v), inserted);
-    }
-    const rgmc::Grid grid(border.Whole, border.Whole);
-    this->Masks.resize(this->N);
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      const double x[3] = { static_cast<double>(this->X[3 * v]),
-        static_cast<double>(this->X[3 * v + 1]), static_cast<double>(this->X[3 * v + 2]) };
-      this->Masks[v] = border.Mask(grid, static_cast<vtkIdType>(local.Ids[v].A), x);
-    }
-    // Triangles over the vertices.
-    vtkCellArray* polys = input->GetPolys();
-    this->Triangles.reserve(3 * polys->GetNumberOfCells());
-    vtkIdType npts;
-    const vtkIdType* pts;
-    for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        this->Triangles.push_back(local.Of[pts[k]]);
-      }
-    }
     this->Partners.assign(ranks.Size, false);
     for (int s : numbering.Sharers)
     {
@@ -400,380 +463,504 @@ public:
   }
 
   /// The edges at each vertex (with repeats: once per triangle side), gathered at owners;
-  /// smoothing stencils of owned vertices; global checks. Collective.
-  Checks Analyze()
+  /// smoothing stencils of owned vertices; global checks. Collective; false (on every rank, with
+  /// `problem`) on failure.
+  bool Analyze(bool stencils, Checks& checks, std::string& problem)
   {
-    // This rank's edges at each vertex, in compressed rows, sorted by the neighbour's gid.
-    std::vector<vtkIdType> offsets(this->N + 1, 0);
-    for (std::size_t t = 0; t < this->Triangles.size(); t += 3)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        offsets[this->Triangles[t + k] + 1] += 2;
-      }
-    }
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      offsets[v + 1] += offsets[v];
-    }
-    std::vector<vtkIdType> ends(offsets.begin(), offsets.end() - 1), edges(offsets[this->N]);
-    for (std::size_t t = 0; t < this->Triangles.size(); t += 3)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        const vtkIdType v = this->Triangles[t + k];
-        edges[ends[v]++] = this->Triangles[t + (k + 1) % 3];
-        edges[ends[v]++] = this->Triangles[t + (k + 2) % 3];
-      }
-    }
+    const int P = this->R.Size, me = this->R.Rank;
     const std::vector<vtkIdType>& gid = this->Num.Gid;
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      std::sort(edges.begin() + offsets[v], edges.begin() + offsets[v + 1],
-        [&gid](vtkIdType a, vtkIdType b) { return gid[a] < gid[b]; });
-    }
-    auto localNeighbours = [&](vtkIdType v, std::vector<Neighbour>& out) {
-      for (vtkIdType e = offsets[v]; e < offsets[v + 1];)
+    std::vector<Neighbour> all;
+    std::vector<std::pair<vtkIdType, vtkIdType>> ends; // (gid, vertex) of edge ends
+    // The corners of the triangles at each vertex, in compressed rows.
+    std::vector<vtkIdType> cornerOffsets, corners;
+    // The ends of this rank's edges at vertex v (once per triangle side), sorted by gid.
+    auto localEnds = [&](vtkIdType v) {
+      ends.clear();
+      for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
       {
-        vtkIdType end = e;
-        while (end < offsets[v + 1] && edges[end] == edges[e])
+        const vtkIdType t = corners[c] / 3, k = corners[c] % 3;
+        for (vtkIdType other : { (k + 1) % 3, (k + 2) % 3 })
+        {
+          const vtkIdType w = static_cast<vtkIdType>(this->Triangles[3 * t + other]);
+          ends.emplace_back(gid[w], w);
+        }
+      }
+      std::sort(ends.begin(), ends.end());
+    };
+    // This rank's edges at vertex v, sorted by the neighbour's gid, into `out`.
+    auto localNeighbours = [&](vtkIdType v, std::vector<Neighbour>& out) {
+      localEnds(v);
+      for (std::size_t e = 0; e < ends.size();)
+      {
+        std::size_t end = e;
+        while (end < ends.size() && ends[end].first == ends[e].first)
         {
           ++end;
         }
-        const vtkIdType w = edges[e];
-        Neighbour nb{ gid[w], static_cast<int>(end - e), w, this->R.Rank, 0, { 0, 0, 0 } };
-        for (int k = 0; k < 3; ++k)
-        {
-          nb.X[k] = static_cast<double>(this->X[3 * w + k]);
-        }
-        nb.Mask = this->MaskOf(w);
-        out.push_back(nb);
+        out.push_back(Neighbour{ ends[e].first, static_cast<int>(end - e), ends[e].second, me, 0,
+          { 0, 0, 0 } });
         e = end;
       }
     };
 
-    // Edges at shared vertices go to their owners.
-    std::vector<std::vector<vtkIdType>> outgoing(this->R.Size);
-    std::vector<Neighbour> scratch;
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      const int owner = this->Num.Owner[v];
-      if (owner == this->R.Rank || !this->Num.Shared(v))
-      {
-        continue;
-      }
-      scratch.clear();
-      localNeighbours(v, scratch);
-      std::vector<vtkIdType>& out = outgoing[owner];
-      out.push_back(gid[v]);
-      out.push_back(static_cast<vtkIdType>(scratch.size()));
-      for (const Neighbour& nb : scratch)
-      {
-        out.insert(out.end(), { nb.Gid, nb.Uses, nb.Mask, PackDouble(nb.X[0]),
-                                PackDouble(nb.X[1]), PackDouble(nb.X[2]) });
-      }
-    }
-    const auto incoming = this->R.Exchange(outgoing, this->Partners, EdgesTag);
-    std::map<vtkIdType, std::vector<Neighbour>> received; // by the owned vertex's gid
-    for (int s = 0; s < this->R.Size; ++s)
-    {
-      const std::vector<vtkIdType>& in = incoming[s];
-      if (s == this->R.Rank)
-      {
-        continue;
-      }
-      for (std::size_t i = 0; i < in.size();)
-      {
-        std::vector<Neighbour>& list = received[in[i]];
-        const vtkIdType count = in[i + 1];
-        i += 2;
-        for (vtkIdType j = 0; j < count; ++j, i += 6)
-        {
-          Neighbour nb{ in[i], static_cast<int>(in[i + 1]), -1, s, static_cast<int>(in[i + 2]),
-            { UnpackDouble(in[i + 3]), UnpackDouble(in[i + 4]), UnpackDouble(in[i + 5]) } };
-          if (const std::int32_t* w = this->Index.Find(nb.Gid))
+    // Edges at shared vertices go to their owners (shared vertices in gid order: each owner
+    // receives them in its own order).
+    std::vector<std::vector<vtkIdType>> outgoing(P);
+    if (!this->R.Step("list the edges at the seams", problem, [&]() {
+          cornerOffsets.assign(static_cast<std::size_t>(this->N) + 1, 0);
+          for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
           {
-            nb.Local = *w;
+            ++cornerOffsets[static_cast<vtkIdType>(this->Triangles[c]) + 1];
           }
-          list.push_back(nb);
-        }
-      }
-    }
-
-    // Every owned vertex: its whole neighbourhood, the checks, its stencil.
-    Checks checks;
-    std::vector<Neighbour> all;
-    std::vector<rgmc::IncidentEdge> incident;
-    std::map<vtkIdType, vtkIdType> remoteSlot; // gid -> slot among the remote neighbours
-    const double cosEdgeAngle = std::cos(vtkMath::RadiansFromDegrees(15.0));
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      if (this->Num.Owner[v] != this->R.Rank)
-      {
-        continue;
-      }
-      all.clear();
-      localNeighbours(v, all);
-      auto more = received.find(gid[v]);
-      if (more != received.end())
-      {
-        all.insert(all.end(), more->second.begin(), more->second.end());
-        std::stable_sort(all.begin(), all.end(),
-          [](const Neighbour& a, const Neighbour& b) { return a.Gid < b.Gid; });
-        // Merge the ranks' counts of each edge; keep a local copy of the neighbour if any.
-        std::size_t kept = 0;
-        for (std::size_t i = 0; i < all.size(); ++i)
-        {
-          if (kept > 0 && all[kept - 1].Gid == all[i].Gid)
+          for (vtkIdType v = 0; v < this->N; ++v)
           {
-            all[kept - 1].Uses += all[i].Uses;
-            if (all[kept - 1].Local < 0 && all[i].Local >= 0)
+            cornerOffsets[v + 1] += cornerOffsets[v];
+          }
+          corners.resize(static_cast<std::size_t>(3 * this->NumTriangles));
+          std::vector<vtkIdType> fill(cornerOffsets.begin(), cornerOffsets.end() - 1);
+          for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
+          {
+            corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = c;
+          }
+          for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
+          {
+            const int owner = this->Num.SharedOwner[i];
+            if (owner == me)
             {
-              all[kept - 1].Local = all[i].Local;
+              continue;
+            }
+            const vtkIdType v = this->Num.SharedVertex[i];
+            all.clear();
+            localNeighbours(v, all);
+            std::vector<vtkIdType>& out = outgoing[owner];
+            out.push_back(gid[v]);
+            out.push_back(static_cast<vtkIdType>(all.size()));
+            for (const Neighbour& nb : all)
+            {
+              const T* x = this->X + 3 * nb.Local;
+              out.insert(out.end(), { nb.Gid, nb.Uses, this->MaskOf(nb.Local),
+                                      PackDouble(static_cast<double>(x[0])),
+                                      PackDouble(static_cast<double>(x[1])),
+                                      PackDouble(static_cast<double>(x[2])) });
             }
           }
-          else
+        }))
+    {
+      return false;
+    }
+    const auto incoming = this->R.Exchange(outgoing, this->Partners, EdgesTag);
+    std::vector<std::vector<vtkIdType>>().swap(outgoing);
+
+    // Every owned vertex, in gid order: its whole neighbourhood, the checks, its stencil.
+    struct Pending // a neighbour held elsewhere, until remote slots are numbered
+    {
+      vtkIdType Gid;
+      int Provider;
+      double X[3];
+    };
+    std::vector<Pending> pending;
+    if (!this->R.Step("make the smoothing stencils", problem, [&]() {
+          std::vector<std::size_t> cursor(P, 0);
+          std::vector<rgmc::IncidentEdge> incident;
+          std::vector<std::int64_t> stencil;
+          const double cosEdgeAngle = std::cos(vtkMath::RadiansFromDegrees(15.0));
+          if (stencils)
           {
-            all[kept++] = all[i];
+            this->Owned.reserve(static_cast<std::size_t>(this->N));
+            this->Stencil.Offsets.reserve(static_cast<std::size_t>(this->N) + 1);
+            this->Stencil.Neighbours.reserve(static_cast<std::size_t>(3 * this->NumTriangles));
           }
-        }
-        all.resize(kept);
-      }
-      const int myMask = this->MaskOf(v);
-      incident.clear();
-      for (const Neighbour& nb : all)
+          // Any vertex: its whole neighbourhood (with the edges other ranks sent, for a shared
+          // one), the checks, its stencil.
+          auto general = [&](vtkIdType v, bool isShared, std::size_t sharedIndex) {
+              all.clear();
+              localNeighbours(v, all);
+              if (isShared)
+              {
+                for (vtkIdType h = this->Num.SharerOffsets[sharedIndex];
+                     h < this->Num.SharerOffsets[sharedIndex + 1]; ++h)
+                {
+                  const int s = this->Num.Sharers[h];
+                  const std::vector<vtkIdType>& in = incoming[s];
+                  std::size_t& i = cursor[s];
+                  if (i + 1 >= in.size() || in[i] != gid[v])
+                  {
+                    continue;
+                  }
+                  const vtkIdType count = in[i + 1];
+                  i += 2;
+                  for (vtkIdType j = 0; j < count; ++j, i += 6)
+                  {
+                    all.push_back(Neighbour{ in[i], static_cast<int>(in[i + 1]), -1, s,
+                      static_cast<int>(in[i + 2]),
+                      { UnpackDouble(in[i + 3]), UnpackDouble(in[i + 4]),
+                        UnpackDouble(in[i + 5]) } });
+                  }
+                }
+                std::stable_sort(all.begin(), all.end(),
+                  [](const Neighbour& a, const Neighbour& b) { return a.Gid < b.Gid; });
+                // Merge the ranks' counts of each edge; keep the local copy of the neighbour.
+                std::size_t kept = 0;
+                for (std::size_t i = 0; i < all.size(); ++i)
+                {
+                  if (kept > 0 && all[kept - 1].Gid == all[i].Gid)
+                  {
+                    all[kept - 1].Uses += all[i].Uses;
+                    if (all[kept - 1].Local < 0 && all[i].Local >= 0)
+                    {
+                      all[kept - 1] = Neighbour{ all[i].Gid, all[kept - 1].Uses, all[i].Local, me,
+                        0, { 0, 0, 0 } };
+                    }
+                  }
+                  else
+                  {
+                    all[kept++] = all[i];
+                  }
+                }
+                all.resize(kept);
+              }
+              const int myMask = this->MaskOf(v);
+              incident.clear();
+              for (const Neighbour& nb : all)
+              {
+                incident.push_back(rgmc::IncidentEdge{ nb.Gid, nb.Uses });
+                if (nb.Gid > gid[v])
+                {
+                  ++checks.Edges;
+                  if (nb.Uses == 1)
+                  {
+                    const int mask = nb.Local >= 0 ? this->MaskOf(nb.Local) : nb.Mask;
+                    ++((myMask & mask) ? checks.Border : checks.Boundary);
+                  }
+                  else if (nb.Uses > 2)
+                  {
+                    ++checks.NonManifold;
+                  }
+                }
+              }
+              if (!stencils)
+              {
+                return;
+              }
+              auto find = [&all](vtkIdType g) -> const Neighbour& {
+                return *std::lower_bound(all.begin(), all.end(), g,
+                  [](const Neighbour& nb, vtkIdType key) { return nb.Gid < key; });
+              };
+              auto position = [&](const Neighbour& nb, T x[3]) {
+                for (int k = 0; k < 3; ++k)
+                {
+                  x[k] = nb.Local >= 0 ? this->X[3 * nb.Local + k] : static_cast<T>(nb.X[k]);
+                }
+              };
+              rgmc::SmoothingStencil(
+                incident,
+                [&](std::int64_t a, std::int64_t b) {
+                  T pa[3], pb[3];
+                  position(find(a), pa);
+                  position(find(b), pb);
+                  return rgmc::ExceedsEdgeAngle(pa, this->X + 3 * v, pb, cosEdgeAngle);
+                },
+                stencil);
+              this->Owned.push_back(v);
+              for (std::int64_t g : stencil)
+              {
+                const Neighbour& nb = find(g);
+                if (nb.Local >= 0)
+                {
+                  this->Stencil.Neighbours.push_back(nb.Local);
+                  continue;
+                }
+                this->Stencil.Neighbours.push_back(-1 - static_cast<std::int64_t>(pending.size()));
+                pending.push_back(Pending{ nb.Gid, nb.Provider, { nb.X[0], nb.X[1], nb.X[2] } });
+              }
+              this->Stencil.Offsets.push_back(
+                static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+          };
+          // Vertices no other rank holds, in memory order: most are inside a closed manifold
+          // piece of the surface, where every edge has two triangles and the stencil is simply
+          // the neighbours in gid order.
+          for (vtkIdType v = 0; v < this->N; ++v)
+          {
+            if (this->Num.Holding[v] != Numbering::Alone)
+            {
+              continue;
+            }
+            localEnds(v);
+            bool manifold = !ends.empty() && ends.size() < 2 * 255;
+            for (std::size_t e = 0; e < ends.size() && manifold; e += 2)
+            {
+              manifold = e + 1 < ends.size() && ends[e + 1].first == ends[e].first &&
+                (e + 2 == ends.size() || ends[e + 2].first != ends[e].first);
+            }
+            if (!manifold)
+            {
+              general(v, false, 0);
+              continue;
+            }
+            for (std::size_t e = 0; e < ends.size(); e += 2)
+            {
+              checks.Edges += ends[e].first > gid[v];
+            }
+            if (stencils)
+            {
+              this->Owned.push_back(v);
+              for (std::size_t e = 0; e < ends.size(); e += 2)
+              {
+                this->Stencil.Neighbours.push_back(ends[e].second);
+              }
+              this->Stencil.Offsets.push_back(
+                static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+            }
+          }
+          // Shared vertices this rank owns, in gid order (the order of the received edges).
+          for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
+          {
+            if (this->Num.SharedOwner[i] == me)
+            {
+              general(this->Num.SharedVertex[i], true, i);
+            }
+          }
+          std::vector<vtkIdType>().swap(corners);
+          std::vector<vtkIdType>().swap(cornerOffsets);
+
+          // The neighbours held elsewhere get slots N, N + 1, ... in gid order.
+          std::vector<vtkIdType> order(pending.size()), slotOf(pending.size());
+          std::iota(order.begin(), order.end(), vtkIdType(0));
+          std::sort(order.begin(), order.end(),
+            [&pending](vtkIdType a, vtkIdType b) { return pending[a].Gid < pending[b].Gid; });
+          for (vtkIdType o : order)
+          {
+            const Pending& p = pending[o];
+            if (this->RemoteGids.empty() || this->RemoteGids.back() != p.Gid)
+            {
+              this->RemoteGids.push_back(p.Gid);
+              this->RemoteProviders.push_back(p.Provider);
+              this->RemoteInitial.insert(this->RemoteInitial.end(), p.X, p.X + 3);
+            }
+            slotOf[o] = static_cast<vtkIdType>(this->RemoteGids.size()) - 1;
+          }
+          for (std::int64_t& s : this->Stencil.Neighbours)
+          {
+            s = s < 0 ? this->N + slotOf[-1 - s] : s;
+          }
+          // Who sends what each iteration: the neighbours owners lack, from ranks that hold
+          // them; the owners' new positions, to the other holders (both sides list a pair's
+          // vertices in gid order).
+          for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
+          {
+            this->RequestLists[this->RemoteProviders[r]].push_back(this->RemoteGids[r]);
+            this->RemoteOrder[this->RemoteProviders[r]].push_back(
+              this->N + static_cast<vtkIdType>(r));
+          }
+          for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
+          {
+            const vtkIdType v = this->Num.SharedVertex[i];
+            if (this->Num.SharedOwner[i] == me)
+            {
+              for (vtkIdType h = this->Num.SharerOffsets[i]; h < this->Num.SharerOffsets[i + 1];
+                   ++h)
+              {
+                this->ToSharer[this->Num.Sharers[h]].push_back(v);
+              }
+            }
+            else
+            {
+              this->FromOwner[this->Num.SharedOwner[i]].push_back(v);
+            }
+          }
+        }))
+    {
+      return false;
+    }
+    const auto asked = this->R.Exchange(this->RequestLists, this->Partners, RequestTag);
+    std::vector<std::vector<vtkIdType>>().swap(this->RequestLists);
+    return this->R.Step("plan the smoothing's exchanges", problem, [&]() {
+      for (int s = 0; s < P; ++s)
       {
-        incident.push_back(rgmc::IncidentEdge{ nb.Gid, nb.Uses });
-        if (nb.Gid > gid[v])
+        for (vtkIdType g : asked[s])
         {
-          ++checks.Edges;
-          if (nb.Uses == 1)
-          {
-            ++((myMask & nb.Mask) ? checks.Border : checks.Boundary);
-          }
-          else if (nb.Uses > 2)
-          {
-            ++checks.NonManifold;
-          }
+          this->Provide[s].push_back(this->VertexOfGid(g));
         }
       }
-      auto position = [&](vtkIdType g, T x[3]) {
-        for (const Neighbour& nb : all)
-        {
-          if (nb.Gid == g)
+    });
+  }
+
+  /// Smooths the positions into Smoothed. Returns false when aborted or failed (with
+  /// `problem`). Collective.
+  bool Smooth(int method, int iterations, double relaxation, double passBand,
+    rgmc::SincWindow window, const std::function<bool(double)>& progress, std::string& problem)
+  {
+    const std::size_t size = 3 * (this->N + this->RemoteGids.size());
+    std::vector<T> a, b, c, sum;
+    std::vector<double> coefficients;
+    const bool sinc = method == vtkRGSeamRepair::WINDOWED_SINC;
+    if (!this->R.Step("smooth the surface", problem, [&]() {
+          a.resize(size);
+          b.resize(size);
+          std::copy(this->X, this->X + 3 * this->N, a.begin());
+          for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
           {
             for (int k = 0; k < 3; ++k)
             {
-              x[k] = static_cast<T>(nb.X[k]);
+              a[3 * (this->N + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
             }
           }
-        }
-      };
-      const std::vector<std::int64_t> stencil = rgmc::SmoothingStencil(
-        incident, [&](std::int64_t a, std::int64_t b) {
-          T pa[3], pb[3];
-          position(a, pa);
-          position(b, pb);
-          return rgmc::ExceedsEdgeAngle(pa, &this->X[3 * v], pb, cosEdgeAngle);
-        });
-      std::vector<std::int64_t> slots;
-      for (std::int64_t g : stencil)
-      {
-        const Neighbour* nb = nullptr;
-        for (const Neighbour& candidate : all)
-        {
-          nb = candidate.Gid == g ? &candidate : nb;
-        }
-        if (nb->Local >= 0)
-        {
-          slots.push_back(nb->Local);
-          continue;
-        }
-        auto found = remoteSlot.find(g);
-        if (found == remoteSlot.end())
-        {
-          found = remoteSlot.emplace(g, static_cast<vtkIdType>(this->RemoteGids.size())).first;
-          this->RemoteGids.push_back(g);
-          this->RemoteProviders.push_back(nb->Provider);
-          this->RemoteInitial.insert(this->RemoteInitial.end(), nb->X, nb->X + 3);
-        }
-        slots.push_back(-1 - found->second); // remote: resolved to N + slot below
-      }
-      this->Owned.push_back(v);
-      this->Stencil.Add(slots);
-    }
-    for (std::int64_t& s : this->Stencil.Neighbours)
+          if (sinc)
+          {
+            c.resize(size);
+            sum.resize(size);
+            coefficients = rgmc::SincCoefficients(iterations, passBand, window);
+          }
+        }))
     {
-      s = s < 0 ? this->N + (-1 - s) : s;
+      return false;
     }
-    this->PlanExchanges();
-    return checks;
-  }
-
-  /// Smooths in place (positions of this rank's vertices, in the input's precision).
-  /// Returns false when aborted. Collective.
-  bool Smooth(int method, int iterations, double relaxation, double passBand,
-    rgmc::SincWindow window, const std::function<bool(double)>& progress)
-  {
-    const std::size_t size = 3 * (this->N + this->RemoteGids.size());
-    std::vector<T> a(size), b(size);
-    std::copy(this->X.begin(), this->X.end(), a.begin());
-    for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
+    bool aborted = false;
+    if (!sinc)
     {
-      for (int k = 0; k < 3; ++k)
-      {
-        a[3 * (this->N + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
-      }
-    }
-    if (method == vtkRGSeamRepair::LAPLACIAN)
-    {
-      for (int it = 0; it < iterations; ++it)
+      for (int it = 0; it < iterations && !aborted; ++it)
       {
         if (progress(double(it) / iterations))
         {
-          return false;
+          aborted = true;
+          break;
         }
         this->Fetch(a.data());
         rgmc::LaplacianStep(this->Stencil, this->Owned, a.data(), b.data(), relaxation);
         this->Update(b.data());
         std::swap(a, b);
       }
-      std::copy(a.begin(), a.begin() + 3 * this->N, this->X.begin());
-      return true;
+      this->Smoothed.swap(a);
     }
-    // Windowed sinc: x0 = a, x1 = b, x2 = c, x3 = sum.
-    const std::vector<double> coefficients = rgmc::SincCoefficients(iterations, passBand, window);
-    std::vector<T> c(size), sum(size);
-    T* x0 = a.data();
-    T* x1 = b.data();
-    T* x2 = c.data();
-    this->Fetch(x0);
-    rgmc::SincFirstStep(this->Stencil, this->Owned, x0, x1, sum.data(), coefficients.data());
-    this->Update(x1);
-    for (int it = 2; it <= iterations; ++it)
+    else
     {
-      if (progress(double(it) / iterations))
+      // Windowed sinc: x0 = a, x1 = b, x2 = c, x3 = sum.
+      T* x0 = a.data();
+      T* x1 = b.data();
+      T* x2 = c.data();
+      this->Fetch(x0);
+      rgmc::SincFirstStep(this->Stencil, this->Owned, x0, x1, sum.data(), coefficients.data());
+      this->Update(x1);
+      for (int it = 2; it <= iterations; ++it)
       {
-        return false;
+        if (progress(double(it) / iterations))
+        {
+          aborted = true;
+          break;
+        }
+        this->Fetch(x1);
+        rgmc::SincStep(this->Stencil, this->Owned, x0, x1, x2, sum.data(), coefficients[it]);
+        this->Update(x2);
+        T* oldest = x0;
+        x0 = x1;
+        x1 = x2;
+        x2 = oldest;
       }
-      this->Fetch(x1);
-      rgmc::SincStep(this->Stencil, this->Owned, x0, x1, x2, sum.data(), coefficients[it]);
-      this->Update(x2);
-      T* oldest = x0;
-      x0 = x1;
-      x1 = x2;
-      x2 = oldest;
+      this->Update(sum.data());
+      this->Smoothed.swap(sum);
     }
-    this->Update(sum.data());
-    std::copy(sum.begin(), sum.begin() + 3 * this->N, this->X.begin());
+    if (!this->R.Agree(true, problem) || aborted)
+    {
+      return false;
+    }
+    this->Smoothed.resize(3 * this->N);
     return true;
   }
 
-  /// Area-weighted vertex normals of the current positions, summed at owners. Collective.
-  std::vector<float> Normals()
+  /// Area-weighted vertex normals of the smoothed positions, summed at owners. Collective; empty
+  /// on failure (on every rank, with `problem`).
+  std::vector<float> Normals(std::string& problem)
   {
-    std::vector<double> n(3 * this->N, 0.0);
-    for (std::size_t t = 0; t < this->Triangles.size(); t += 3)
-    {
-      const T* p0 = &this->X[3 * this->Triangles[t]];
-      const T* p1 = &this->X[3 * this->Triangles[t + 1]];
-      const T* p2 = &this->X[3 * this->Triangles[t + 2]];
-      double e1[3], e2[3], cross[3];
-      for (int k = 0; k < 3; ++k)
-      {
-        e1[k] = static_cast<double>(p1[k]) - static_cast<double>(p0[k]);
-        e2[k] = static_cast<double>(p2[k]) - static_cast<double>(p0[k]);
-      }
-      vtkMath::Cross(e1, e2, cross);
-      for (int k = 0; k < 3; ++k)
-      {
-        for (int corner = 0; corner < 3; ++corner)
-        {
-          n[3 * this->Triangles[t + corner] + k] += cross[k];
-        }
-      }
-    }
-    // Partial sums of shared vertices to their owners, added in rank order; results back.
+    std::vector<double> n;
     std::vector<std::vector<double>> partial(this->R.Size);
-    for (int o = 0; o < this->R.Size; ++o)
+    if (!this->R.Step("compute normals", problem, [&]() {
+          n.assign(3 * this->N, 0.0);
+          const T* x = this->Smoothed.data();
+          for (vtkIdType t = 0; t < this->NumTriangles; ++t)
+          {
+            const vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
+              static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
+              static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
+            double e1[3], e2[3], cross[3];
+            for (int k = 0; k < 3; ++k)
+            {
+              e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
+              e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
+            }
+            vtkMath::Cross(e1, e2, cross);
+            for (int k = 0; k < 3; ++k)
+            {
+              for (int corner = 0; corner < 3; ++corner)
+              {
+                n[3 * c[corner] + k] += cross[k];
+              }
+            }
+          }
+          // Partial sums of shared vertices to their owners, added in rank order; results back.
+          for (int o = 0; o < this->R.Size; ++o)
+          {
+            for (vtkIdType v : this->FromOwner[o])
+            {
+              partial[o].insert(partial[o].end(), &n[3 * v], &n[3 * v] + 3);
+            }
+          }
+        }))
     {
-      for (vtkIdType v : this->FromOwner[o])
-      {
-        partial[o].insert(partial[o].end(), &n[3 * v], &n[3 * v] + 3);
-      }
+      return {};
     }
     const auto sums = this->R.Exchange(partial, this->Partners, NormalTag);
-    for (int s = 0; s < this->R.Size; ++s)
+    std::vector<float> normals;
+    if (!this->R.Step("compute normals", problem, [&]() {
+          for (int s = 0; s < this->R.Size; ++s)
+          {
+            if (s == this->R.Rank)
+            {
+              continue;
+            }
+            const std::vector<vtkIdType>& list = this->ToSharer[s];
+            for (std::size_t i = 0; i < list.size() && 3 * i + 2 < sums[s].size(); ++i)
+            {
+              for (int k = 0; k < 3; ++k)
+              {
+                n[3 * list[i] + k] += sums[s][3 * i + k];
+              }
+            }
+          }
+          for (vtkIdType v = 0; v < this->N; ++v)
+          {
+            vtkMath::Normalize(&n[3 * v]);
+          }
+        }))
     {
-      if (s == this->R.Rank)
-      {
-        continue;
-      }
-      const std::vector<vtkIdType>& list = this->ToSharer[s];
-      for (std::size_t i = 0; i < list.size(); ++i)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          n[3 * list[i] + k] += sums[s][3 * i + k];
-        }
-      }
-    }
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      vtkMath::Normalize(&n[3 * v]);
+      return {};
     }
     this->Update(n.data(), NormalBackTag);
-    return std::vector<float>(n.begin(), n.end());
+    if (!this->R.Step("compute normals", problem, [&]() { normals.assign(n.begin(), n.end()); }))
+    {
+      return {};
+    }
+    return normals;
   }
 
-  std::vector<T> X;                  // positions of this rank's vertices
-  std::vector<vtkIdType> Triangles;  // over this rank's vertices
+  std::vector<T> Smoothed; // positions of this rank's vertices after smoothing
 
 private:
-  int MaskOf(vtkIdType v) const { return this->Masks[v]; }
-
-  /// Who sends what each iteration: the neighbours owners lack, from ranks that hold them; the
-  /// owners' new positions, to the other holders. Collective.
-  void PlanExchanges()
+  int MaskOf(vtkIdType v) const
   {
-    std::vector<std::vector<vtkIdType>> requests(this->R.Size);
-    for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
-    {
-      requests[this->RemoteProviders[r]].push_back(this->RemoteGids[r]);
-      this->RemoteOrder[this->RemoteProviders[r]].push_back(this->N + static_cast<vtkIdType>(r));
-    }
-    const auto asked = this->R.Exchange(requests, this->Partners, RequestTag);
-    for (int s = 0; s < this->R.Size; ++s)
-    {
-      for (vtkIdType g : asked[s])
-      {
-        this->Provide[s].push_back(*this->Index.Find(g));
-      }
-    }
-    for (vtkIdType v = 0; v < this->N; ++v)
-    {
-      const int owner = this->Num.Owner[v];
-      if (owner == this->R.Rank)
-      {
-        for (vtkIdType s = this->Num.SharerOffsets[v]; s < this->Num.SharerOffsets[v + 1]; ++s)
-        {
-          this->ToSharer[this->Num.Sharers[s]].push_back(v);
-        }
-      }
-      else
-      {
-        this->FromOwner[owner].push_back(v);
-      }
-    }
-    // Both sides list a pair's vertices in gid order (this rank's vertices are in that order).
+    const T* x = this->X + 3 * v;
+    const double p[3] = { static_cast<double>(x[0]), static_cast<double>(x[1]),
+      static_cast<double>(x[2]) };
+    return this->Border.Mask(
+      this->Grid, this->Keys ? this->Keys[this->Local.PointOf(v)] : vtkIdType(0), p);
   }
 
-  static void Gather(const std::vector<vtkIdType>& list, const T* state, std::vector<double>& out)
+  /// The vertex with global id `g` (this rank holds it): its vertices in identity order are in
+  /// gid order.
+  vtkIdType VertexOfGid(vtkIdType g) const
   {
-    for (vtkIdType v : list)
-    {
-      out.insert(out.end(), state + 3 * v, state + 3 * v + 3);
-    }
+    const std::vector<vtkIdType>& gid = this->Num.Gid;
+    return *std::lower_bound(this->Local.Sorted.begin(), this->Local.Sorted.end(), g,
+      [&gid](vtkIdType v, vtkIdType key) { return gid[v] < key; });
   }
 
   /// Fills the remote slots of `state` with the neighbours' states from their holders.
@@ -782,13 +969,16 @@ private:
     std::vector<std::vector<double>> out(this->R.Size);
     for (int s = 0; s < this->R.Size; ++s)
     {
-      Gather(this->Provide[s], state, out[s]);
+      for (vtkIdType v : this->Provide[s])
+      {
+        out[s].insert(out[s].end(), state + 3 * v, state + 3 * v + 3);
+      }
     }
     const auto in = this->R.Exchange(out, this->Partners, StateTag);
     for (int s = 0; s < this->R.Size; ++s)
     {
       const std::vector<vtkIdType>& slots = this->RemoteOrder[s];
-      for (std::size_t i = 0; i < slots.size(); ++i)
+      for (std::size_t i = 0; i < slots.size() && 3 * i + 2 < in[s].size(); ++i)
       {
         for (int k = 0; k < 3; ++k)
         {
@@ -818,7 +1008,7 @@ private:
         continue;
       }
       const std::vector<vtkIdType>& list = this->FromOwner[o];
-      for (std::size_t i = 0; i < list.size(); ++i)
+      for (std::size_t i = 0; i < list.size() && 3 * i + 2 < in[o].size(); ++i)
       {
         for (int k = 0; k < 3; ++k)
         {
@@ -829,24 +1019,27 @@ private:
   }
 
   Ranks& R;
-  vtkPolyData* Input;
   const LocalVertices& Local;
   const Numbering& Num;
-  BorderTest Border;
+  const BorderTest Border;
+  const rgmc::Grid Grid;
+  const vtkIdType* Keys; // the input's vertex keys, or null
+  const T* X;            // positions of this rank's vertices
+  const I* Triangles;    // over this rank's vertices
+  const vtkIdType NumTriangles;
   const vtkIdType N;
-  rgmc::KeyMap Index; // gid -> this rank's vertex
-  std::vector<int> Masks; // the volume faces each vertex lies on
-  std::vector<bool> Partners;
+  std::vector<bool> Partners; // the ranks that share a vertex with this one
 
   std::vector<std::int64_t> Owned; // the vertices this rank moves, one stencil row each
   rgmc::Stencils Stencil;
-  std::vector<vtkIdType> RemoteGids; // neighbours of owned vertices held elsewhere
+  std::vector<vtkIdType> RemoteGids; // neighbours of owned vertices held elsewhere, by slot
   std::vector<int> RemoteProviders;
   std::vector<double> RemoteInitial;
-  std::map<int, std::vector<vtkIdType>> RemoteOrder; // provider -> slots, in request order
-  std::map<int, std::vector<vtkIdType>> Provide;     // requester -> vertices to send
-  std::map<int, std::vector<vtkIdType>> ToSharer;    // holder -> owned shared vertices
-  std::map<int, std::vector<vtkIdType>> FromOwner;   // owner -> vertices it updates here
+  std::vector<std::vector<vtkIdType>> ToSharer;    // holder -> owned shared vertices
+  std::vector<std::vector<vtkIdType>> FromOwner;   // owner -> vertices it updates here
+  std::vector<std::vector<vtkIdType>> Provide;     // requester -> vertices to send
+  std::vector<std::vector<vtkIdType>> RemoteOrder; // provider -> slots, in request order
+  std::vector<std::vector<vtkIdType>> RequestLists; // provider -> gids asked of it
 };
 
 } // namespace
@@ -904,20 +1097,39 @@ int vtkRGSeamRepair::RequestData(
     return 0;
   }
   vtkIdType localTriangles = input->GetNumberOfPolys(), triangles = 0;
-  ranks.C->AllReduce(&localTriangles, &triangles, 1, vtkCommunicator::SUM_OP);
-  if (triangles == 0)
+  ranks.Check(ranks.C->AllReduce(&localTriangles, &triangles, 1, vtkCommunicator::SUM_OP),
+    "counting triangles");
+  if (!ranks.Agree(triangles > 0, problem))
   {
-    vtkErrorMacro(<< "Cannot repair the seams: the input has no triangles.");
+    vtkErrorMacro(<< "Cannot repair the seams: "
+                  << (problem.empty() ? std::string("the input has no triangles") : problem)
+                  << ".");
     return 0;
   }
   this->UpdateProgress(0.05);
 
-  // Vertex identities: global ids when every rank with points has them, else coordinates.
-  vtkIdTypeArray* keys = vtkIdTypeArray::SafeDownCast(input->GetPointData()->GetGlobalIds());
-  int keyed = input->GetNumberOfPoints() == 0 || keys ? 1 : 0, allKeyed = 0;
-  ranks.C->AllReduce(&keyed, &allKeyed, 1, vtkCommunicator::MIN_OP);
-  const LocalVertices local = MergeLocal(input, allKeyed ? keys : nullptr);
-  const Numbering numbering = Number(ranks, local.Ids);
+  // PASS 1: this rank's distinct vertices and their global numbering. Identities are global ids
+  // when every rank with points has them, else exact coordinates.
+  vtkIdTypeArray* keyArray = vtkIdTypeArray::SafeDownCast(input->GetPointData()->GetGlobalIds());
+  int keyed = input->GetNumberOfPoints() == 0 || keyArray ? 1 : 0, allKeyed = 0;
+  ranks.Check(ranks.C->AllReduce(&keyed, &allKeyed, 1, vtkCommunicator::MIN_OP),
+    "agreeing on vertex identities");
+  const vtkIdType* keys = allKeyed && keyArray ? keyArray->GetPointer(0) : nullptr;
+  LocalVertices local;
+  Numbering numbering;
+  auto number = [&](auto words) {
+    constexpr int Words = decltype(words)::value;
+    std::vector<Identity<Words>> ids;
+    return ranks.Step("sort the vertices", problem,
+             [&]() { local = MergeLocal<Words>(input, keys, ids); }) &&
+      Number<Words>(ranks, local, ids, numbering, problem);
+  };
+  if (!(allKeyed ? number(std::integral_constant<int, 1>())
+                 : number(std::integral_constant<int, 3>())))
+  {
+    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
+    return 0;
+  }
   this->UpdateProgress(0.25);
 
   // How to tell edges on the volume's border: from keys and the whole extent when the input
@@ -931,8 +1143,8 @@ int vtkRGSeamRepair::RequestData(
       lo[a] = input->GetNumberOfPoints() ? b[2 * a] : VTK_DOUBLE_MAX;
       hi[a] = input->GetNumberOfPoints() ? b[2 * a + 1] : VTK_DOUBLE_MIN;
     }
-    ranks.C->AllReduce(lo, glo, 3, vtkCommunicator::MIN_OP);
-    ranks.C->AllReduce(hi, ghi, 3, vtkCommunicator::MAX_OP);
+    ranks.Check(ranks.C->AllReduce(lo, glo, 3, vtkCommunicator::MIN_OP), "reducing bounds");
+    ranks.Check(ranks.C->AllReduce(hi, ghi, 3, vtkCommunicator::MAX_OP), "reducing bounds");
     double diagonal = 0;
     for (int a = 0; a < 3; ++a)
     {
@@ -942,7 +1154,7 @@ int vtkRGSeamRepair::RequestData(
     }
     border.Tolerance = 1e-6 * std::sqrt(diagonal);
     vtkIntArray* whole = vtkIntArray::SafeDownCast(input->GetFieldData()->GetArray("WholeExtent"));
-    if (allKeyed && whole && whole->GetNumberOfValues() == 6)
+    if (keys && whole && whole->GetNumberOfValues() == 6)
     {
       border.Keys = true;
       for (int i = 0; i < 6; ++i)
@@ -952,9 +1164,14 @@ int vtkRGSeamRepair::RequestData(
     }
   }
 
-  // The repair proper, in the input points' precision.
+  // PASS 2-4: edges at the seams, checks, smoothing, normals; in the input points' precision,
+  // over the input's own connectivity when no points were merged.
+  const bool smooth = this->SmoothingMethod != NO_SMOOTHING && this->NumberOfIterations > 0;
+  const bool doublePoints =
+    input->GetPoints() && input->GetPoints()->GetDataType() == VTK_DOUBLE;
+  vtkDataArray* inputConnectivity = input->GetPolys()->GetConnectivityArray();
+  std::vector<vtkIdType> connectivityCopy; // when the input's cannot be used as it is
   vtkNew<vtkPoints> points;
-  std::vector<vtkIdType> connectivity;
   std::vector<float> normals;
   Checks checks;
   bool aborted = false;
@@ -962,107 +1179,203 @@ int vtkRGSeamRepair::RequestData(
     this->UpdateProgress(0.4 + 0.5 * fraction);
     return ranks.Any(this->CheckAbort());
   };
-  auto run = [&](auto zero) {
-    using T = decltype(zero);
-    Repair<T> repair(ranks, input, local, numbering, border);
-    checks = repair.Analyze();
+  auto run = [&](auto pointType, auto indexType) -> bool {
+    using T = decltype(pointType);
+    using I = decltype(indexType);
+    const T* x = nullptr;
+    std::vector<T> xCopy;
+    const I* tris = nullptr;
+    if (!ranks.Step("copy the input", problem, [&]() {
+          using PointArray = vtkAOSDataArrayTemplate<T>;
+          PointArray* inputPoints =
+            input->GetPoints() ? PointArray::FastDownCast(input->GetPoints()->GetData()) : nullptr;
+          if (inputPoints && !local.Merged())
+          {
+            x = inputPoints->GetPointer(0);
+          }
+          else
+          {
+            xCopy.resize(static_cast<std::size_t>(3 * local.Count));
+            for (vtkIdType v = 0; v < local.Count; ++v)
+            {
+              double p[3];
+              input->GetPoint(local.PointOf(v), p);
+              for (int k = 0; k < 3; ++k)
+              {
+                xCopy[3 * v + k] = static_cast<T>(p[k]);
+              }
+            }
+            x = xCopy.data();
+          }
+          using IndexArray = vtkAOSDataArrayTemplate<I>;
+          IndexArray* typed = IndexArray::FastDownCast(inputConnectivity);
+          if (typed && !local.Merged())
+          {
+            tris = typed->GetPointer(0); // every cell is a triangle (PASS 0)
+          }
+          else if constexpr (std::is_same<I, vtkIdType>::value)
+          {
+            connectivityCopy.reserve(static_cast<std::size_t>(3 * input->GetNumberOfPolys()));
+            vtkCellArray* polys = input->GetPolys();
+            vtkIdType npts;
+            const vtkIdType* pts;
+            for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+            {
+              for (int k = 0; k < 3; ++k)
+              {
+                connectivityCopy.push_back(local.VertexOf(pts[k]));
+              }
+            }
+            tris = connectivityCopy.data();
+          }
+        }))
+    {
+      return false;
+    }
+    Repair<T, I> repair(ranks, local, numbering, border, keys, x, tris, input->GetNumberOfPolys());
+    if (!repair.Analyze(smooth, checks, problem))
+    {
+      return false;
+    }
     this->UpdateProgress(0.4);
-    const bool smooth = this->SmoothingMethod != NO_SMOOTHING && this->NumberOfIterations > 0;
     if (smooth)
     {
-      aborted = !repair.Smooth(this->SmoothingMethod, this->NumberOfIterations,
-        this->RelaxationFactor, this->PassBand,
-        this->WindowFunction == HAMMING_WINDOW ? rgmc::SincWindow::Hamming
-                                               : rgmc::SincWindow::Nuttall,
-        progress);
-      if (!aborted)
+      if (!repair.Smooth(this->SmoothingMethod, this->NumberOfIterations, this->RelaxationFactor,
+            this->PassBand,
+            this->WindowFunction == HAMMING_WINDOW ? rgmc::SincWindow::Hamming
+                                                   : rgmc::SincWindow::Nuttall,
+            progress, problem))
       {
-        normals = repair.Normals();
+        aborted = problem.empty();
+        return false;
+      }
+      normals = repair.Normals(problem);
+      if (normals.empty() && local.Count > 0)
+      {
+        return false;
       }
     }
-    points->SetDataType(std::is_same<T, float>::value ? VTK_FLOAT : VTK_DOUBLE);
-    points->SetNumberOfPoints(static_cast<vtkIdType>(local.Ids.size()));
-    for (std::size_t v = 0; v < local.Ids.size(); ++v)
-    {
-      points->SetPoint(static_cast<vtkIdType>(v), static_cast<double>(repair.X[3 * v]),
-        static_cast<double>(repair.X[3 * v + 1]), static_cast<double>(repair.X[3 * v + 2]));
-    }
-    connectivity.swap(repair.Triangles);
+    // The output's points: the input's own when nothing moved and nothing was merged.
+    return ranks.Step("store the output points", problem, [&]() {
+      const std::vector<T>& moved = smooth ? repair.Smoothed : xCopy;
+      if (!smooth && !local.Merged())
+      {
+        points->ShallowCopy(input->GetPoints());
+        return;
+      }
+      vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
+      xyz->SetNumberOfComponents(3);
+      if (!xyz->SetNumberOfValues(3 * local.Count))
+      {
+        throw std::bad_alloc();
+      }
+      std::copy(moved.begin(), moved.begin() + 3 * local.Count, xyz->GetPointer(0));
+      points->SetData(xyz);
+    });
   };
-  if (input->GetPoints() && input->GetPoints()->GetDataType() == VTK_FLOAT)
+  // A connectivity copy is always 64-bit; the input's own may be 32-bit.
+  const bool int32 = !local.Merged() && vtkTypeInt32Array::FastDownCast(inputConnectivity);
+  bool ok;
+  if (doublePoints)
   {
-    run(float());
+    ok = int32 ? run(double(), std::int32_t()) : run(double(), vtkIdType());
   }
   else
   {
-    run(double());
+    ok = int32 ? run(float(), std::int32_t()) : run(float(), vtkIdType());
   }
   if (aborted)
   {
     output->Initialize();
     return 1;
   }
+  if (!ok)
+  {
+    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
+    output->Initialize();
+    return 0;
+  }
 
   // Global checks.
   vtkIdType counts[4] = { checks.Edges, checks.Boundary, checks.Border, checks.NonManifold },
-            sums[4];
-  ranks.C->AllReduce(counts, sums, 4, vtkCommunicator::SUM_OP);
+            sums[4] = { 0, 0, 0, 0 };
+  ranks.Check(ranks.C->AllReduce(counts, sums, 4, vtkCommunicator::SUM_OP), "summing the checks");
   const vtkIdType euler = numbering.Total - sums[0] + triangles;
   const bool closed = sums[1] == 0 && sums[3] == 0;
 
-  // PASS 5: the output.
-  const vtkIdType n = static_cast<vtkIdType>(local.Ids.size());
+  // PASS 5: the output: the input's triangles and point data as they are (merged when points
+  // were), global ids, duplicate flags, smoothed points and their normals.
+  const vtkIdType n = local.Count;
   output->Initialize();
-  output->SetPoints(points);
-  vtkNew<vtkCellArray> polys;
+  if (!ranks.Step("build the output", problem, [&]() {
+        output->SetPoints(points);
+        vtkPointData* pd = output->GetPointData();
+        pd->CopyGlobalIdsOff();
+        if (smooth)
+        {
+          pd->CopyNormalsOff();
+        }
+        if (!local.Merged())
+        {
+          output->SetPolys(input->GetPolys());
+          pd->PassData(input->GetPointData());
+        }
+        else
+        {
+          vtkNew<vtkIdTypeArray> offsets, conn;
+          const vtkIdType numTris = static_cast<vtkIdType>(connectivityCopy.size() / 3);
+          if (!offsets->SetNumberOfValues(numTris + 1) ||
+            !conn->SetNumberOfValues(static_cast<vtkIdType>(connectivityCopy.size())))
+          {
+            throw std::bad_alloc();
+          }
+          for (vtkIdType t = 0; t <= numTris; ++t)
+          {
+            offsets->SetValue(t, 3 * t);
+          }
+          std::copy(connectivityCopy.begin(), connectivityCopy.end(), conn->GetPointer(0));
+          vtkNew<vtkCellArray> polys;
+          polys->SetData(offsets, conn);
+          output->SetPolys(polys);
+          pd->CopyAllocate(input->GetPointData(), n);
+          for (vtkIdType v = 0; v < n; ++v)
+          {
+            pd->CopyData(input->GetPointData(), local.PointOf(v), v);
+          }
+        }
+        output->GetCellData()->PassData(input->GetCellData());
+        vtkNew<vtkIdTypeArray> gids;
+        gids->SetName("GlobalPointIds");
+        vtkNew<vtkUnsignedCharArray> ghosts;
+        ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+        if (!gids->SetNumberOfValues(n) || !ghosts->SetNumberOfValues(n))
+        {
+          throw std::bad_alloc();
+        }
+        std::copy(numbering.Gid.begin(), numbering.Gid.end(), gids->GetPointer(0));
+        for (vtkIdType v = 0; v < n; ++v)
+        {
+          ghosts->SetValue(v, (numbering.Holding[v] & Numbering::Foreign) ? vtkDataSetAttributes::DUPLICATEPOINT : 0);
+        }
+        pd->SetGlobalIds(gids);
+        pd->AddArray(ghosts);
+        if (smooth)
+        {
+          vtkNew<vtkFloatArray> normalArray;
+          normalArray->SetName("Normals");
+          normalArray->SetNumberOfComponents(3);
+          if (!normalArray->SetNumberOfValues(3 * n))
+          {
+            throw std::bad_alloc();
+          }
+          std::copy(normals.begin(), normals.end(), normalArray->GetPointer(0));
+          pd->SetNormals(normalArray);
+        }
+      }))
   {
-    vtkNew<vtkIdTypeArray> offsets, conn;
-    const vtkIdType numTris = static_cast<vtkIdType>(connectivity.size() / 3);
-    offsets->SetNumberOfTuples(numTris + 1);
-    for (vtkIdType t = 0; t <= numTris; ++t)
-    {
-      offsets->SetValue(t, 3 * t);
-    }
-    conn->SetNumberOfTuples(static_cast<vtkIdType>(connectivity.size()));
-    std::copy(connectivity.begin(), connectivity.end(), conn->GetPointer(0));
-    polys->SetData(offsets, conn);
-  }
-  output->SetPolys(polys);
-  output->GetCellData()->PassData(input->GetCellData());
-
-  vtkPointData* pd = output->GetPointData();
-  pd->CopyGlobalIdsOff();
-  const bool smoothed = !normals.empty();
-  if (smoothed)
-  {
-    pd->CopyNormalsOff();
-  }
-  pd->CopyAllocate(input->GetPointData(), n);
-  for (vtkIdType v = 0; v < n; ++v)
-  {
-    pd->CopyData(input->GetPointData(), local.First[v], v);
-  }
-  vtkNew<vtkIdTypeArray> gids;
-  gids->SetName("GlobalPointIds");
-  gids->SetNumberOfTuples(n);
-  vtkNew<vtkUnsignedCharArray> ghosts;
-  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-  ghosts->SetNumberOfTuples(n);
-  for (vtkIdType v = 0; v < n; ++v)
-  {
-    gids->SetValue(v, numbering.Gid[v]);
-    ghosts->SetValue(v, numbering.Owner[v] == ranks.Rank ? 0 : vtkDataSetAttributes::DUPLICATEPOINT);
-  }
-  pd->SetGlobalIds(gids);
-  pd->AddArray(ghosts);
-  if (smoothed)
-  {
-    vtkNew<vtkFloatArray> normalArray;
-    normalArray->SetName("Normals");
-    normalArray->SetNumberOfComponents(3);
-    normalArray->SetNumberOfTuples(n);
-    std::copy(normals.begin(), normals.end(), normalArray->GetPointer(0));
-    pd->SetNormals(normalArray);
+    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
+    output->Initialize();
+    return 0;
   }
 
   vtkFieldData* fd = output->GetFieldData();

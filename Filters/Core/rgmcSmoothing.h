@@ -25,15 +25,16 @@ struct IncidentEdge
 };
 
 /// The neighbours a vertex is smoothed toward (empty: the vertex is fixed), by the rules of
-/// vtkWindowedSincPolyDataFilter with boundary smoothing on. `incident` holds the vertex's
-/// distinct edges sorted by neighbour. A vertex whose edges are all manifold (used twice) uses
-/// all its neighbours; one with exactly two boundary edges (used once), or exactly two
-/// non-manifold edges, is smoothed along them unless `exceedsEdgeAngle(a, b)` (the path a,
-/// vertex, b turns by more than the edge angle); anything else is fixed.
+/// vtkWindowedSincPolyDataFilter with boundary smoothing on, written into `stencil`. `incident`
+/// holds the vertex's distinct edges sorted by neighbour. A vertex whose edges are all manifold
+/// (used twice) uses all its neighbours; one with exactly two boundary edges (used once), or
+/// exactly two non-manifold edges, is smoothed along them unless `exceedsEdgeAngle(a, b)` (the
+/// path a, vertex, b turns by more than the edge angle); anything else is fixed.
 template <typename ExceedsEdgeAngle>
-std::vector<std::int64_t> SmoothingStencil(
-  const std::vector<IncidentEdge>& incident, ExceedsEdgeAngle&& exceedsEdgeAngle)
+void SmoothingStencil(const std::vector<IncidentEdge>& incident,
+  ExceedsEdgeAngle&& exceedsEdgeAngle, std::vector<std::int64_t>& stencil)
 {
+  stencil.clear();
   int uses = 0;
   for (const IncidentEdge& e : incident)
   {
@@ -42,46 +43,44 @@ std::vector<std::int64_t> SmoothingStencil(
   // No edges, a dangling end, or more than VTK's 255 smoothing edges: fixed.
   if (uses <= 1 || uses >= 2 * 255)
   {
-    return {};
+    return;
   }
-  std::vector<std::int64_t> all, boundary, nonManifold;
+  std::int64_t boundary[2], nonManifold[2];
+  int numBoundary = 0, numNonManifold = 0;
   for (const IncidentEdge& e : incident)
   {
     if (e.Uses == 1)
     {
-      if (boundary.size() == 2)
+      if (numBoundary == 2)
       {
-        return {};
+        return;
       }
-      boundary.push_back(e.Neighbour);
+      boundary[numBoundary++] = e.Neighbour;
     }
     else if (e.Uses > 2)
     {
-      if (nonManifold.size() == 2)
+      if (numNonManifold == 2)
       {
-        return {};
+        return;
       }
-      nonManifold.push_back(e.Neighbour);
+      nonManifold[numNonManifold++] = e.Neighbour;
     }
-    all.push_back(e.Neighbour);
   }
-  if (boundary.empty() && nonManifold.empty())
+  if (numBoundary == 0 && numNonManifold == 0)
   {
-    return all;
-  }
-  for (const std::vector<std::int64_t>* pair : { &boundary, &nonManifold })
-  {
-    const std::vector<std::int64_t>& other = pair == &boundary ? nonManifold : boundary;
-    if (pair->size() == 2 && other.empty())
+    for (const IncidentEdge& e : incident)
     {
-      if (exceedsEdgeAngle((*pair)[0], (*pair)[1]))
-      {
-        return {};
-      }
-      return *pair;
+      stencil.push_back(e.Neighbour);
     }
+    return;
   }
-  return {};
+  const std::int64_t* pair = numBoundary == 2 && numNonManifold == 0 ? boundary
+    : numNonManifold == 2 && numBoundary == 0                        ? nonManifold
+                                                                     : nullptr;
+  if (pair && !exceedsEdgeAngle(pair[0], pair[1]))
+  {
+    stencil.assign(pair, pair + 2);
+  }
 }
 
 /// Whether the path p0 -> p1 -> p2 turns by more than the angle whose cosine is `cosAngle`

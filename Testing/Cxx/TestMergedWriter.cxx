@@ -59,6 +59,46 @@ vtkSmartPointer<vtkPolyData> Repair(vtkMultiProcessController* controller, vtkPo
   return out;
 }
 
+/// The 1-rank mesh as the files hold it: points (and point data) in global-id order, the
+/// triangles over them.
+vtkSmartPointer<vtkPolyData> InGlobalIdOrder(vtkPolyData* mesh)
+{
+  vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(mesh->GetPointData()->GetGlobalIds());
+  const vtkIdType n = mesh->GetNumberOfPoints();
+  vtkNew<vtkIdList> from, to;
+  for (vtkIdType p = 0; p < n; ++p)
+  {
+    from->InsertNextId(p);
+    to->InsertNextId(ids->GetValue(p));
+  }
+  auto ordered = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataType(mesh->GetPoints()->GetDataType());
+  points->SetNumberOfPoints(n);
+  for (vtkIdType p = 0; p < n; ++p)
+  {
+    points->SetPoint(ids->GetValue(p), mesh->GetPoint(p));
+  }
+  ordered->SetPoints(points);
+  ordered->GetPointData()->CopyAllocate(mesh->GetPointData(), n);
+  ordered->GetPointData()->CopyData(mesh->GetPointData(), from, to);
+  vtkNew<vtkCellArray> polys;
+  vtkIdType npts;
+  const vtkIdType* pts;
+  vtkCellArray* in = mesh->GetPolys();
+  for (in->InitTraversal(); in->GetNextCell(npts, pts);)
+  {
+    std::vector<vtkIdType> cell;
+    for (vtkIdType k = 0; k < npts; ++k)
+    {
+      cell.push_back(ids->GetValue(pts[k]));
+    }
+    polys->InsertNextCell(npts, cell.data());
+  }
+  ordered->SetPolys(polys);
+  return ordered;
+}
+
 struct Written
 {
   bool Ok = false;
@@ -223,14 +263,13 @@ int main(int argc, char* argv[])
     vtkSmartPointer<vtkImageData> whole = Skull(Whole);
     vtkSmartPointer<vtkPolyData> extracted =
       Extract(single, whole, 400, vtkRGMarchingCubes::SEEDED, seeds).Output;
-    reference = Repair(single, extracted);
+    reference = InGlobalIdOrder(Repair(single, extracted));
     vtkNew<vtkRGSeamRepair> numbering;
     numbering->SetController(single);
     numbering->SetInputData(extracted);
     numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
     numbering->Update();
-    unsmoothed = vtkSmartPointer<vtkPolyData>::New();
-    unsmoothed->ShallowCopy(numbering->GetOutput());
+    unsmoothed = InGlobalIdOrder(numbering->GetOutput());
     std::cout << "1-rank skull: " << reference->GetNumberOfPoints() << " vertices, "
               << reference->GetNumberOfPolys() << " triangles\n";
   }
