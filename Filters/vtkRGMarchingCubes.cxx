@@ -4,6 +4,7 @@
 
 #include "rgmcCaseTable.h"
 #include "rgmcGrower.h"
+#include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 
 #include "vtkArrayDispatch.h"
@@ -302,29 +303,34 @@ struct Decision
 };
 
 /// Joins the local components of all ranks through their ports and decides, on rank 0, which
-/// to keep. Collective.
-Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
-  const rgmc::Ownership& own, int mode, std::vector<int>& rootIndex)
+/// to keep. Collective; false on every rank (with `problem`) when it failed on one.
+bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc::Ownership& own,
+  int mode, std::vector<int>& rootIndex, Decision& decision, std::string& problem)
 {
   std::vector<rgmc::Component>& comps = grower.Components();
-  rootIndex.assign(comps.size(), -1);
   std::vector<int> roots;
-  for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+  if (!ranks.Step("join the components", problem, [&]() {
+        rootIndex.assign(comps.size(), -1);
+        for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+        {
+          if (grower.Root(c) == c)
+          {
+            rootIndex[c] = static_cast<int>(roots.size());
+            roots.push_back(c);
+          }
+        }
+        for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+        {
+          rootIndex[c] = rootIndex[grower.Root(c)];
+        }
+      }))
   {
-    if (grower.Root(c) == c)
-    {
-      rootIndex[c] = static_cast<int>(roots.size());
-      roots.push_back(c);
-    }
-  }
-  for (int c = 0; c < static_cast<int>(comps.size()); ++c)
-  {
-    rootIndex[c] = rootIndex[grower.Root(c)];
+    return false;
   }
 
   vtkIdType localCount = static_cast<vtkIdType>(roots.size());
   std::vector<vtkIdType> counts(ranks.Size), offsets(ranks.Size + 1, 0);
-  ranks.C->AllGather(&localCount, counts.data(), 1);
+  ranks.Check(ranks.C->AllGather(&localCount, counts.data(), 1), "gathering component counts");
   for (int r = 0; r < ranks.Size; ++r)
   {
     offsets[r + 1] = offsets[r] + counts[r];
@@ -334,6 +340,7 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
   // Ports go to the ranks that own the other cubes around them.
   std::vector<std::vector<vtkIdType>> outgoing(ranks.Size);
   std::vector<std::pair<std::int64_t, vtkIdType>> mine;
+  if (!ranks.Step("list the components' crossings", problem, [&]() {
   for (const rgmc::Port& port : grower.Ports())
   {
     const vtkIdType gid = myOffset + rootIndex[port.Component];
@@ -363,6 +370,10 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
       outgoing[owner].push_back(gid);
     }
   }
+      }))
+  {
+    return false;
+  }
   std::vector<bool> partners(ranks.Size, false);
   const rgmc::CellBox near = own.Mine().Grown(1);
   for (int r = 0; r < ranks.Size; ++r)
@@ -374,6 +385,10 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
     ranks.Exchange(outgoing, partners, PortTag);
 
   // Edges of the component graph: my component and theirs share a vertex.
+  const vtkIdType total = offsets[ranks.Size];
+  std::vector<vtkIdType> info, flatEdges, allInfo;
+  std::vector<vtkIdType> infoLengths(ranks.Size), infoOffsets(ranks.Size);
+  if (!ranks.Step("join the components", problem, [&]() {
   std::sort(mine.begin(), mine.end());
   std::vector<std::pair<vtkIdType, vtkIdType>> edges;
   for (const std::vector<vtkIdType>& list : incoming)
@@ -392,7 +407,6 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
 
   // Gather the small component graph on rank 0.
-  std::vector<vtkIdType> info;
   info.reserve(3 * roots.size());
   for (int c : roots)
   {
@@ -400,36 +414,46 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
     info.push_back(comps[c].MinKey);
     info.push_back(comps[c].Seeded ? 1 : 0);
   }
-  std::vector<vtkIdType> flatEdges;
   for (const auto& e : edges)
   {
     flatEdges.push_back(e.first);
     flatEdges.push_back(e.second);
   }
-  const vtkIdType total = offsets[ranks.Size];
-  std::vector<vtkIdType> infoLengths(ranks.Size), infoOffsets(ranks.Size);
   for (int r = 0; r < ranks.Size; ++r)
   {
     infoLengths[r] = 3 * counts[r];
     infoOffsets[r] = 3 * offsets[r];
   }
-  std::vector<vtkIdType> allInfo(ranks.Rank == 0 ? 3 * total + 1 : 1);
-  ranks.C->GatherV(info.data(), allInfo.data(), static_cast<vtkIdType>(info.size()),
-    infoLengths.data(), infoOffsets.data(), 0);
+  allInfo.resize(ranks.Rank == 0 ? 3 * total + 1 : 1);
+      }))
+  {
+    return false;
+  }
+  ranks.Check(ranks.C->GatherV(info.data(), allInfo.data(), static_cast<vtkIdType>(info.size()),
+                infoLengths.data(), infoOffsets.data(), 0),
+    "gathering the components");
   vtkIdType edgeLength = static_cast<vtkIdType>(flatEdges.size());
   std::vector<vtkIdType> edgeLengths(ranks.Size), edgeOffsets(ranks.Size + 1, 0);
   // Every rank learns every length: VTK 9.5's GatherV reads the lengths and offsets on all ranks.
-  ranks.C->AllGather(&edgeLength, edgeLengths.data(), 1);
+  ranks.Check(ranks.C->AllGather(&edgeLength, edgeLengths.data(), 1), "gathering edge counts");
   for (int r = 0; r < ranks.Size; ++r)
   {
     edgeOffsets[r + 1] = edgeOffsets[r] + edgeLengths[r];
   }
-  std::vector<vtkIdType> allEdges(ranks.Rank == 0 ? edgeOffsets[ranks.Size] + 1 : 1);
-  ranks.C->GatherV(flatEdges.data(), allEdges.data(), edgeLength, edgeLengths.data(),
-    edgeOffsets.data(), 0);
+  std::vector<vtkIdType> allEdges, finalIds;
+  if (!ranks.Step("join the components", problem, [&]() {
+        allEdges.resize(ranks.Rank == 0 ? edgeOffsets[ranks.Size] + 1 : 1);
+      }))
+  {
+    return false;
+  }
+  ranks.Check(ranks.C->GatherV(flatEdges.data(), allEdges.data(), edgeLength,
+                edgeLengths.data(), edgeOffsets.data(), 0),
+    "gathering the component graph");
 
-  std::vector<vtkIdType> finalIds(ranks.Rank == 0 ? total + 1 : 1, -1);
   vtkIdType totals[2] = { 0, 0 };
+  if (!ranks.Step("decide which components to keep", problem, [&]() {
+  finalIds.assign(ranks.Rank == 0 ? total + 1 : 1, -1);
   if (ranks.Rank == 0)
   {
     std::vector<vtkIdType> parent(total);
@@ -501,15 +525,25 @@ Decision Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid,
       finalIds[c] = idOfClass[find(c)];
     }
   }
-  Decision decision;
   decision.FinalId.assign(static_cast<std::size_t>(localCount) + 1, -1);
-  ranks.C->ScatterV(
-    finalIds.data(), decision.FinalId.data(), counts.data(), offsets.data(), localCount, 0);
+      }))
+  {
+    return false;
+  }
+  ranks.Check(ranks.C->ScatterV(finalIds.data(), decision.FinalId.data(), counts.data(),
+                offsets.data(), localCount, 0),
+    "scattering the decision");
   decision.FinalId.resize(static_cast<std::size_t>(localCount));
-  ranks.C->Broadcast(totals, 2, 0);
+  ranks.Check(ranks.C->Broadcast(totals, 2, 0), "broadcasting the totals");
   decision.Triangles = totals[0];
   decision.Components = totals[1];
-  return decision;
+  // Component ids are 32-bit in the output (ComponentId, like vtkConnectivityFilter's RegionId).
+  if (decision.Components > VTK_INT_MAX)
+  {
+    problem = "the surface has " + std::to_string(decision.Components) +
+      " components, more than ComponentId can number (" + std::to_string(VTK_INT_MAX) + ")";
+  }
+  return ranks.Agree(problem.empty(), problem);
 }
 
 /// Global range of the scalars (only on failure paths, to explain an empty result).
@@ -954,24 +988,34 @@ int vtkRGMarchingCubes::RequestData(
   this->UpdateProgress(0.1);
 
   // PASS 3: local growth, on every rank at once.
-  if (this->ExtractionMode == SEEDED)
+  std::string outOfMemory;
+  try
   {
-    for (vtkIdType key : seedKeys)
+    if (this->ExtractionMode == SEEDED)
     {
-      grower.GrowFromKey(key); // seeded components; before the boundary growth
+      for (vtkIdType key : seedKeys)
+      {
+        grower.GrowFromKey(key); // seeded components; before the boundary growth
+      }
+      if (ranks.Size > 1)
+      {
+        grower.GrowBoundary();
+      }
     }
-    if (ranks.Size > 1)
+    else
     {
-      grower.GrowBoundary();
+      grower.GrowAll();
     }
+    grower.Extract();
   }
-  else
+  catch (const std::bad_alloc&)
   {
-    grower.GrowAll();
+    outOfMemory = "not enough memory to grow and extract the surface on rank " +
+      std::to_string(ranks.Rank) + " (" + std::to_string(grower.Mesh().NumberOfTriangles()) +
+      " triangles so far)";
   }
-  grower.Extract();
   {
-    std::string error = grower.Error();
+    std::string error = outOfMemory.empty() ? grower.Error() : outOfMemory;
     if (!ranks.Agree(error.empty(), error))
     {
       vtkErrorMacro(<< "Cannot extract a surface: " << error << ".");
@@ -992,10 +1036,18 @@ int vtkRGMarchingCubes::RequestData(
 
   // PASS 4: join components across ranks; decide what to keep.
   std::vector<int> rootIndex;
-  const Decision decision = Resolve(ranks, grower, grid, own, this->ExtractionMode, rootIndex);
+  Decision decision;
+  if (!Resolve(ranks, grower, grid, own, this->ExtractionMode, rootIndex, decision, problem))
+  {
+    vtkErrorMacro(<< "Cannot extract a surface: " << problem << ".");
+    output->Initialize();
+    return 0;
+  }
   this->UpdateProgress(0.9);
 
   // PASS 5: the output piece. The kernel's buffers become the output arrays without copies.
+  output->Initialize();
+  if (!ranks.Step("store the surface", problem, [&]() {
   rgmc::LocalMesh& mesh = grower.Mesh();
   mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
   const vtkIdType numPoints = mesh.NumberOfPoints();
@@ -1035,8 +1087,7 @@ int vtkRGMarchingCubes::RequestData(
 
   // Triangles: 32-bit connectivity, adopted as is.
   vtkNew<vtkTypeInt32Array> offsets, connectivity;
-  offsets->SetNumberOfTuples(numKept + 1);
-  std::int32_t* o = offsets->GetPointer(0);
+  std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
   for (vtkIdType n = 0; n <= numKept; ++n)
   {
     o[n] = static_cast<std::int32_t>(3 * n);
@@ -1051,10 +1102,8 @@ int vtkRGMarchingCubes::RequestData(
     vtkAbstractArray::VTK_DATA_ARRAY_FREE);
   vtkNew<vtkIntArray> rankIds;
   rankIds->SetName("RankId");
-  rankIds->SetNumberOfTuples(numKept);
-  rankIds->FillValue(ranks.Rank);
+  std::fill_n(rgmc::Allocate(rankIds.Get(), numKept), numKept, ranks.Rank);
 
-  output->Initialize();
   output->SetPoints(points);
   output->SetPolys(polys);
   if (this->ComputeNormals)
@@ -1066,6 +1115,12 @@ int vtkRGMarchingCubes::RequestData(
   // No active scalars: ParaView shows the surface in one colour, as Contour's; colouring by
   // RankId (the decomposition) or ComponentId is the user's choice.
   output->GetCellData()->AddArray(componentIds);
+      }))
+  {
+    vtkErrorMacro(<< "Cannot extract a surface: " << problem << ".");
+    output->Initialize();
+    return 0;
+  }
 
   vtkNew<vtkIdTypeArray> seedKeyArray;
   seedKeyArray->SetName("SeedVertexKeys");

@@ -863,9 +863,10 @@ void vtkRGMergedSurfaceWriter::WriteData()
       static_cast<Int>(mesh.Triangles.size() / 3),
       surface->GetNumberOfPoints() > 0 && !mesh.Normals ? 1 : 0 };
     std::vector<Int> all(3 * static_cast<std::size_t>(ranks.Size));
-    if (ranks.C->AllGather(local, all.data(), 3) == 0)
+    ranks.Check(ranks.C->AllGather(local, all.data(), 3), "exchanging the counts");
+    if (!ranks.Agree(true, problem))
     {
-      fail("the ranks could not exchange their counts");
+      fail(problem);
       return;
     }
     vertices = triangles = firstTriangle = 0;

@@ -5,6 +5,7 @@
 #include "rgmcGrid.h"
 #include "rgmcKeyMap.h"
 #include "rgmcSmoothing.h"
+#include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 
 #include "vtkCellArray.h"
@@ -1265,11 +1266,7 @@ int vtkRGSeamRepair::RequestData(
       }
       vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
       xyz->SetNumberOfComponents(3);
-      if (!xyz->SetNumberOfValues(3 * local.Count))
-      {
-        throw std::bad_alloc();
-      }
-      std::copy(moved.begin(), moved.begin() + 3 * local.Count, xyz->GetPointer(0));
+      std::copy(moved.begin(), moved.begin() + 3 * local.Count, rgmc::Allocate(xyz.Get(), 3 * local.Count));
       points->SetData(xyz);
     });
   };
@@ -1324,16 +1321,13 @@ int vtkRGSeamRepair::RequestData(
         {
           vtkNew<vtkIdTypeArray> offsets, conn;
           const vtkIdType numTris = static_cast<vtkIdType>(connectivityCopy.size() / 3);
-          if (!offsets->SetNumberOfValues(numTris + 1) ||
-            !conn->SetNumberOfValues(static_cast<vtkIdType>(connectivityCopy.size())))
-          {
-            throw std::bad_alloc();
-          }
+          vtkIdType* o = rgmc::Allocate(offsets.Get(), numTris + 1);
           for (vtkIdType t = 0; t <= numTris; ++t)
           {
-            offsets->SetValue(t, 3 * t);
+            o[t] = 3 * t;
           }
-          std::copy(connectivityCopy.begin(), connectivityCopy.end(), conn->GetPointer(0));
+          std::copy(connectivityCopy.begin(), connectivityCopy.end(),
+            rgmc::Allocate(conn.Get(), static_cast<vtkIdType>(connectivityCopy.size())));
           vtkNew<vtkCellArray> polys;
           polys->SetData(offsets, conn);
           output->SetPolys(polys);
@@ -1348,14 +1342,11 @@ int vtkRGSeamRepair::RequestData(
         gids->SetName("GlobalPointIds");
         vtkNew<vtkUnsignedCharArray> ghosts;
         ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-        if (!gids->SetNumberOfValues(n) || !ghosts->SetNumberOfValues(n))
-        {
-          throw std::bad_alloc();
-        }
-        std::copy(numbering.Gid.begin(), numbering.Gid.end(), gids->GetPointer(0));
+        std::copy(numbering.Gid.begin(), numbering.Gid.end(), rgmc::Allocate(gids.Get(), n));
+        unsigned char* ghost = rgmc::Allocate(ghosts.Get(), n);
         for (vtkIdType v = 0; v < n; ++v)
         {
-          ghosts->SetValue(v, (numbering.Holding[v] & Numbering::Foreign) ? vtkDataSetAttributes::DUPLICATEPOINT : 0);
+          ghost[v] = (numbering.Holding[v] & Numbering::Foreign) ? vtkDataSetAttributes::DUPLICATEPOINT : 0;
         }
         pd->SetGlobalIds(gids);
         pd->AddArray(ghosts);
@@ -1364,11 +1355,7 @@ int vtkRGSeamRepair::RequestData(
           vtkNew<vtkFloatArray> normalArray;
           normalArray->SetName("Normals");
           normalArray->SetNumberOfComponents(3);
-          if (!normalArray->SetNumberOfValues(3 * n))
-          {
-            throw std::bad_alloc();
-          }
-          std::copy(normals.begin(), normals.end(), normalArray->GetPointer(0));
+          std::copy(normals.begin(), normals.end(), rgmc::Allocate(normalArray.Get(), 3 * n));
           pd->SetNormals(normalArray);
         }
       }))
