@@ -34,9 +34,11 @@
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTypeInt32Array.h"
+#include "vtkTypeInt64Array.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <limits>
 #include <memory>
@@ -1008,6 +1010,11 @@ int vtkRGMarchingCubes::RequestData(
     }
     grower.Extract();
   }
+  catch (const std::length_error& tooMany)
+  {
+    outOfMemory = std::string(tooMany.what()) + " on rank " + std::to_string(ranks.Rank) +
+      ": run on more ranks";
+  }
   catch (const std::bad_alloc&)
   {
     outOfMemory = "not enough memory to grow and extract the surface on rank " +
@@ -1085,16 +1092,34 @@ int vtkRGMarchingCubes::RequestData(
   keys->SetArray(reinterpret_cast<vtkIdType*>(mesh.Keys.Release()), numPoints, 0,
     vtkAbstractArray::VTK_DATA_ARRAY_FREE);
 
-  // Triangles: 32-bit connectivity, adopted as is.
-  vtkNew<vtkTypeInt32Array> offsets, connectivity;
-  std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-  for (vtkIdType n = 0; n <= numKept; ++n)
-  {
-    o[n] = static_cast<std::int32_t>(3 * n);
-  }
-  connectivity->SetArray(mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+  // Triangles: the kernel's 32-bit connectivity, adopted as is; 64-bit when a rank has more
+  // than 2^31 - 1 corners, where 32-bit offsets would overflow.
   vtkNew<vtkCellArray> polys;
-  polys->SetData(offsets, connectivity);
+  if (3 * numKept <= VTK_TYPE_INT32_MAX)
+  {
+    vtkNew<vtkTypeInt32Array> offsets, connectivity;
+    std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
+    for (vtkIdType n = 0; n <= numKept; ++n)
+    {
+      o[n] = static_cast<std::int32_t>(3 * n);
+    }
+    connectivity->SetArray(
+      mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+    polys->SetData(offsets, connectivity);
+  }
+  else
+  {
+    vtkNew<vtkTypeInt64Array> offsets, connectivity;
+    vtkTypeInt64* o = rgmc::Allocate(offsets.Get(), numKept + 1);
+    for (vtkIdType n = 0; n <= numKept; ++n)
+    {
+      o[n] = 3 * n;
+    }
+    std::copy(mesh.Triangles.begin(), mesh.Triangles.begin() + 3 * numKept,
+      rgmc::Allocate(connectivity.Get(), 3 * numKept));
+    std::free(mesh.Triangles.Release());
+    polys->SetData(offsets, connectivity);
+  }
   vtkNew<vtkIntArray> componentIds;
   componentIds->SetName("ComponentId");
   static_assert(sizeof(int) == sizeof(std::int32_t), "component ids are 32-bit");

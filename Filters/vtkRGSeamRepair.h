@@ -24,20 +24,28 @@
  *
  * Vertices are identified by the input's point global ids when every rank has them (the
  * `VertexKey` of vtkRGMarchingCubes), otherwise by their exact coordinates. The input must be
- * triangles (polygons of 3 points) only.
+ * triangles (polygons of 3 points) only. On a rank whose points are all distinct (the
+ * extraction's output), the output keeps the input's points in their order, its triangles and
+ * its point data as they are (shared, not copied, unless smoothing moved the points);
+ * `GlobalPointIds` gives each point its number. Otherwise a rank's copies of a vertex are merged
+ * into one point.
  *
  * ### Distributed execution
  * Problem: which copies are one vertex, and who owns it, is known only across ranks.
  * Approach: a rendezvous on ranges of identities, then exchanges with neighbouring ranks only.
  * Steps:
  * 1. Each rank sorts its vertex identities; sampled identities give ranges of equal size.
- * 2. Identities go to the rank of their range, which numbers them in order and tells every
- *    sender the global id, owner and other holders of each.
+ * 2. Identities go to the rank of their range, which merges the ranks' sorted streams, numbers
+ *    them in order and answers every sender with the global id of each, and with the holders
+ *    of the few held by several ranks (the lowest owns the vertex).
  * 3. The edges around each seam vertex are gathered at its owner: complete edge counts for the
- *    checks, complete neighbourhoods for the smoothing stencils.
+ *    checks, complete neighbourhoods for the smoothing stencils. The other vertices' stencils
+ *    come from the triangles around them on their own rank.
  * 4. Each smoothing iteration sends, from the ranks that hold them, the neighbour positions
  *    owners need, then the owners' new positions to the other holders.
- * Errors are collective: a problem on one rank is reported by every rank.
+ * Sorted arrays throughout (no per-vertex maps); memory on a rank is proportional to its own
+ * piece. Errors are collective: a problem on one rank, a failed allocation included, is
+ * reported by every rank, and the output is empty.
  *
  * @sa vtkRGMarchingCubes vtkWindowedSincPolyDataFilter vtkSmoothPolyDataFilter
  */

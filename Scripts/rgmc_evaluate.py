@@ -14,6 +14,13 @@ slowest rank's), peak memory per rank; the Hausdorff distances between the N-ran
 surfaces and between our smoothing and VTK's; and the time against the volume's size for the
 same sphere in 128^3 to 1024^3 of empty space. Writes report.md, results.json and PNG plots
 under build/evaluation/. Ranks above the core count are oversubscribed and marked so.
+
+  python3 Scripts/rgmc_evaluate.py --scale    # or: ./rgmc evaluate --scale
+
+The scale benchmark instead: the build's rgmcScale program on 1 and 2 ranks, a 512^3 gyroid
+(about 54 million triangles, one surface through every partition plane) through extraction,
+Seam Repair, 5 Laplacian iterations and the merged writer (STL, then PLY), with the seconds of
+each stage (its slowest rank's) and each rank's peak memory. Writes scale.md and scale.json.
 """
 
 import argparse
@@ -292,10 +299,74 @@ def report(rows, args, pictures):
     return "\n".join(lines) + "\n"
 
 
+def run_scale(args):
+    rows = []
+    for ranks in args.ranks:
+        command = rgmc_common.mpiexec_command(ranks) + [
+            args.scale_binary, "--size", str(args.scale_size), "--period", str(args.scale_period),
+            "--iterations", "5", "--output", os.path.join(args.output, "scale-surface")]
+        print("+ " + " ".join(command), flush=True)
+        process = subprocess.run(command, stdout=subprocess.PIPE, text=True,
+                                 env=rgmc_common.mpi_environment())
+        stages = [json.loads(line) for line in process.stdout.splitlines() if line.startswith("{")]
+        for row in stages:
+            print("  %-12s %2d ranks %8.2f s  peak MiB per rank %s" % (
+                row["stage"], row["ranks"], row["seconds"], row["peak_rss_mib"]), flush=True)
+        if process.returncode != 0:
+            raise rgmc_common.UsageError("rgmcScale on %d ranks failed (exit %d)" % (ranks, process.returncode))
+        rows.extend(stages)
+    return rows
+
+
+def scale_report(rows, args):
+    stages = ["extract", "repair", "smooth", "write stl", "write ply"]
+    counts = sorted({r["ranks"] for r in rows})
+    at = {(r["stage"], r["ranks"]): r for r in rows}
+    triangles = max(r["triangles"] for r in rows)
+    lines = ["# RGMC scale benchmark", "",
+             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
+             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+             "A %d^3 float gyroid (period %g voxels): %d triangles, one surface through every "
+             "partition plane. Extraction (all components, with normals) -> Seam Repair -> 5 Laplacian "
+             "iterations -> merged STL, then PLY, written by every rank into one file. Seconds are the "
+             "slowest rank's; peak memory is each rank's resident-set high-water mark after the stage."
+             % (args.scale_size, args.scale_period, triangles), "",
+             "| stage | " + " | ".join("%d rank%s (s)" % (n, "s" if n > 1 else "") for n in counts) + " |",
+             "|---|" + "---|" * len(counts)]
+    for stage in stages:
+        lines.append("| %s | %s |" % (stage, " | ".join(
+            "%.2f" % at[(stage, n)]["seconds"] if (stage, n) in at else "-" for n in counts)))
+    totals = {n: sum(at[(s, n)]["seconds"] for s in stages if (s, n) in at) for n in counts}
+    lines.append("| **whole job** | %s |" % " | ".join("**%.2f**" % totals[n] for n in counts))
+    lines += ["", "Peak memory per rank (MiB): " + "; ".join(
+        "%d rank%s: %s" % (n, "s" if n > 1 else "", ", ".join("%.0f" % m for m in at[("write ply", n)]["peak_rss_mib"]))
+        for n in counts if ("write ply", n) in at), ""]
+    lines += ["Targets (issue 12):", ""]
+    if 2 in totals:
+        lines.append("- whole job on 2 ranks under 90 s: %.1f s, %s" % (totals[2], "met" if totals[2] < 90 else "NOT met"))
+        peaks = at[("write ply", 2)]["peak_rss_mib"] if ("write ply", 2) in at else []
+        if peaks:
+            ratio = max(peaks) / min(peaks)
+            lines.append("- no rank above 1.3x another's peak: %.2fx, %s" % (ratio, "met" if ratio <= 1.3 else "NOT met"))
+    for n in counts:
+        if ("repair", n) in at and ("extract", n) in at:
+            ratio = at[("repair", n)]["seconds"] / at[("extract", n)]["seconds"]
+            lines.append("- Seam Repair at most the extraction's time, %d rank%s: %.2fx, %s" % (
+                n, "s" if n > 1 else "", ratio, "met" if ratio <= 1.0 else "NOT met"))
+    bytes_per = {}
+    for n in counts:
+        if ("write ply", n) in at:
+            bytes_per[n] = max(at[("write ply", n)]["peak_rss_mib"]) * 2**20 * n / triangles
+    lines += ["", "Peak bytes per triangle (sum over ranks): " + ", ".join(
+        "%d rank%s %.0f" % (n, "s" if n > 1 else "", b) for n, b in bytes_per.items()), ""]
+    return "\n".join(lines)
+
+
 def main(argv):
     parser = argparse.ArgumentParser(prog="rgmc_evaluate.py", description=__doc__.split("\n")[0])
     parser.add_argument("--cases", default="phantom256,phantom512,sphere512,blobs,mri")
-    parser.add_argument("--ranks", default="1,2,4", help="rank counts; the largest is the process set's size")
+    parser.add_argument("--ranks", default=None,
+                        help="rank counts; the largest is the process set's size (default 1,2,4; 1,2 with --scale)")
     parser.add_argument("--sweep", default="128,256,512,1024", help="volume sizes of the sphere sweep")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--sweep-repeats", type=int, default=3)
@@ -304,11 +375,29 @@ def main(argv):
     parser.add_argument("--binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcEvaluation"))
     parser.add_argument("--output", default=os.path.join(rgmc_common.ROOT, "build", "evaluation"),
                         help="folder for report.md, results.json and the plots")
+    parser.add_argument("--scale", action="store_true",
+                        help="the scale benchmark instead (rgmcScale on --ranks, default 1,2)")
+    parser.add_argument("--scale-size", type=int, default=512, help="the gyroid's points per axis")
+    parser.add_argument("--scale-period", type=float, default=24, help="the gyroid's period in voxels")
+    parser.add_argument("--scale-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcScale"))
     parser.add_argument("--report-only", action="store_true",
                         help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)
     args.cases = [c for c in args.cases.split(",") if c]
-    args.ranks = sorted(int(r) for r in args.ranks.split(","))
+    args.ranks = sorted(int(r) for r in (args.ranks or ("1,2" if args.scale else "1,2,4")).split(","))
+    if args.scale:
+        if not os.path.isfile(args.scale_binary):
+            raise rgmc_common.UsageError("no scale program at %s: build first (./rgmc build)" % args.scale_binary)
+        os.makedirs(args.output, exist_ok=True)
+        rows = run_scale(args)
+        with open(os.path.join(args.output, "scale.json"), "w") as out:
+            json.dump(rows, out, indent=1)
+        text = scale_report(rows, args)
+        with open(os.path.join(args.output, "scale.md"), "w") as out:
+            out.write(text)
+        print("\n" + text)
+        print("written: %s" % os.path.join(args.output, "scale.md"))
+        return 0
     args.sweep = [int(n) for n in args.sweep.split(",") if n]
     if not args.report_only and not os.path.isfile(args.binary):
         raise rgmc_common.UsageError("no evaluation program at %s: build first (./rgmc build)" % args.binary)

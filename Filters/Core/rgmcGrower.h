@@ -30,6 +30,7 @@
 #include <functional>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -1225,6 +1226,11 @@ private:
       }
     }
     LocalMesh& m = this->Mesh;
+    // Vertex ids are 32-bit within a rank (slots hold id + 1).
+    if (m.Keys.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() - 1))
+    {
+      throw std::length_error("more than 2147483646 surface vertices in one piece");
+    }
     const std::int32_t id = static_cast<std::int32_t>(m.Keys.size());
     if (this->P.DoublePoints)
     {
