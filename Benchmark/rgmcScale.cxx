@@ -154,8 +154,9 @@ int main(int argc, char* argv[])
     rank, ranks, 1, const_cast<int*>(whole), ghosted, vtkExtentTranslator::BLOCK_MODE, 0);
   const double w = 2.0 * M_PI / opt.Period;
   double t0 = Now();
-  vtkSmartPointer<vtkImageData> volume =
-    rgmc_test::MakeImage(ghosted, VTK_FLOAT, [w](int i, int j, int k) {
+  vtkSmartPointer<vtkImageData> volume = rgmc_test::MakeImage(ghosted, VTK_FLOAT,
+    [w](int i, int j, int k)
+    {
       const double x = w * (i + 0.25), y = w * (j + 0.5), z = w * (k + 0.125);
       return std::sin(x) * std::cos(y) + std::sin(y) * std::cos(z) + std::sin(z) * std::cos(x);
     });
@@ -192,14 +193,16 @@ int main(int argc, char* argv[])
   } smoothing;
   vtkNew<vtkCallbackCommand> progress;
   progress->SetClientData(&smoothing);
-  progress->SetCallback([](vtkObject* caller, unsigned long, void* data, void*) {
-    auto* s = static_cast<Split*>(data);
-    if (s->Time == 0 && static_cast<vtkAlgorithm*>(caller)->GetProgress() >= 0.4)
+  progress->SetCallback(
+    [](vtkObject* caller, unsigned long, void* data, void*)
     {
-      s->Time = Now();
-      s->Peak = StatusMiB("VmHWM:");
-    }
-  });
+      auto* s = static_cast<Split*>(data);
+      if (s->Time == 0 && static_cast<vtkAlgorithm*>(caller)->GetProgress() >= 0.4)
+      {
+        s->Time = Now();
+        s->Peak = StatusMiB("VmHWM:");
+      }
+    });
   repair->AddObserver(vtkCommand::ProgressEvent, progress);
   controller->Barrier();
   t0 = Now();

@@ -20,7 +20,8 @@ template <typename ArrayT>
 typename ArrayT::ValueType* Allocate(ArrayT* array, vtkIdType values)
 {
   using Value = typename ArrayT::ValueType;
-  void* memory = std::malloc(std::max<std::size_t>(1, static_cast<std::size_t>(values)) * sizeof(Value));
+  void* memory =
+    std::malloc(std::max<std::size_t>(1, static_cast<std::size_t>(values)) * sizeof(Value));
   if (!memory)
   {
     throw std::bad_alloc();

@@ -38,8 +38,8 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <array>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -159,7 +159,8 @@ rgmc::CellBox OwnedCells(vtkImageData* input)
     return box;
   }
   const vtkIdType nx = ext[1] - ext[0], nxy = nx * (ext[3] - ext[2]);
-  auto ghost = [&](int i, int j, int k) {
+  auto ghost = [&](int i, int j, int k)
+  {
     const vtkIdType id = (i - ext[0]) + nx * (j - ext[2]) + nxy * (k - ext[4]);
     return (ghosts->GetValue(id) & vtkDataSetAttributes::DUPLICATECELL) != 0;
   };
@@ -290,8 +291,8 @@ struct MakeGrower
   void operator()(ArrayT* array)
   {
     using Range = decltype(vtk::DataArrayValueRange<1>(array));
-    this->Result.reset(
-      new GrowerOf<Range>(vtk::DataArrayValueRange<1>(array), *this->Grid, *this->Own, *this->Params));
+    this->Result.reset(new GrowerOf<Range>(
+      vtk::DataArrayValueRange<1>(array), *this->Grid, *this->Own, *this->Params));
   }
 };
 
@@ -311,21 +312,23 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
 {
   std::vector<rgmc::Component>& comps = grower.Components();
   std::vector<int> roots;
-  if (!ranks.Step("join the components", problem, [&]() {
-        rootIndex.assign(comps.size(), -1);
-        for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+  if (!ranks.Step("join the components", problem,
+        [&]()
         {
-          if (grower.Root(c) == c)
+          rootIndex.assign(comps.size(), -1);
+          for (int c = 0; c < static_cast<int>(comps.size()); ++c)
           {
-            rootIndex[c] = static_cast<int>(roots.size());
-            roots.push_back(c);
+            if (grower.Root(c) == c)
+            {
+              rootIndex[c] = static_cast<int>(roots.size());
+              roots.push_back(c);
+            }
           }
-        }
-        for (int c = 0; c < static_cast<int>(comps.size()); ++c)
-        {
-          rootIndex[c] = rootIndex[grower.Root(c)];
-        }
-      }))
+          for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+          {
+            rootIndex[c] = rootIndex[grower.Root(c)];
+          }
+        }))
   {
     return false;
   }
@@ -342,37 +345,39 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
   // Ports go to the ranks that own the other cubes around them.
   std::vector<std::vector<vtkIdType>> outgoing(ranks.Size);
   std::vector<std::pair<std::int64_t, vtkIdType>> mine;
-  if (!ranks.Step("list the components' crossings", problem, [&]() {
-  for (const rgmc::Port& port : grower.Ports())
-  {
-    const vtkIdType gid = myOffset + rootIndex[port.Component];
-    mine.emplace_back(port.Key, gid);
-    int p[3], axis;
-    grid.Decode(port.Key, p, axis);
-    int sentTo[8], numSent = 0;
-    for (int d = 0; d < 8; ++d)
-    {
-      const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
-      if (axis >= 0 && o[axis] != 0)
-      {
-        continue;
-      }
-      const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
-      if (!grid.HasCell(i, j, k) || own.Owns(i, j, k))
-      {
-        continue;
-      }
-      const int owner = own.Owner(i, j, k);
-      if (owner < 0 || owner == ranks.Rank || std::count(sentTo, sentTo + numSent, owner))
-      {
-        continue;
-      }
-      sentTo[numSent++] = owner;
-      outgoing[owner].push_back(port.Key);
-      outgoing[owner].push_back(gid);
-    }
-  }
-      }))
+  if (!ranks.Step("list the components' crossings", problem,
+        [&]()
+        {
+          for (const rgmc::Port& port : grower.Ports())
+          {
+            const vtkIdType gid = myOffset + rootIndex[port.Component];
+            mine.emplace_back(port.Key, gid);
+            int p[3], axis;
+            grid.Decode(port.Key, p, axis);
+            int sentTo[8], numSent = 0;
+            for (int d = 0; d < 8; ++d)
+            {
+              const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
+              if (axis >= 0 && o[axis] != 0)
+              {
+                continue;
+              }
+              const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
+              if (!grid.HasCell(i, j, k) || own.Owns(i, j, k))
+              {
+                continue;
+              }
+              const int owner = own.Owner(i, j, k);
+              if (owner < 0 || owner == ranks.Rank || std::count(sentTo, sentTo + numSent, owner))
+              {
+                continue;
+              }
+              sentTo[numSent++] = owner;
+              outgoing[owner].push_back(port.Key);
+              outgoing[owner].push_back(gid);
+            }
+          }
+        }))
   {
     return false;
   }
@@ -383,51 +388,54 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
     partners[r] = r != ranks.Rank && !own.Mine().Empty() && !own.BoxOf(r).Empty() &&
       !near.Intersect(own.BoxOf(r)).Empty();
   }
-  const std::vector<std::vector<vtkIdType>> incoming =
-    ranks.Exchange(outgoing, partners, PortTag);
+  const std::vector<std::vector<vtkIdType>> incoming = ranks.Exchange(outgoing, partners, PortTag);
 
   // Edges of the component graph: my component and theirs share a vertex.
   const vtkIdType total = offsets[ranks.Size];
   std::vector<vtkIdType> info, flatEdges, allInfo;
   std::vector<vtkIdType> infoLengths(ranks.Size), infoOffsets(ranks.Size);
-  if (!ranks.Step("join the components", problem, [&]() {
-  std::sort(mine.begin(), mine.end());
-  std::vector<std::pair<vtkIdType, vtkIdType>> edges;
-  for (const std::vector<vtkIdType>& list : incoming)
-  {
-    for (std::size_t n = 0; n + 1 < list.size(); n += 2)
-    {
-      auto it = std::lower_bound(mine.begin(), mine.end(),
-        std::make_pair(static_cast<std::int64_t>(list[n]), std::numeric_limits<vtkIdType>::min()));
-      if (it != mine.end() && it->first == list[n])
-      {
-        edges.emplace_back(std::min(it->second, list[n + 1]), std::max(it->second, list[n + 1]));
-      }
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  if (!ranks.Step("join the components", problem,
+        [&]()
+        {
+          std::sort(mine.begin(), mine.end());
+          std::vector<std::pair<vtkIdType, vtkIdType>> edges;
+          for (const std::vector<vtkIdType>& list : incoming)
+          {
+            for (std::size_t n = 0; n + 1 < list.size(); n += 2)
+            {
+              auto it = std::lower_bound(mine.begin(), mine.end(),
+                std::make_pair(
+                  static_cast<std::int64_t>(list[n]), std::numeric_limits<vtkIdType>::min()));
+              if (it != mine.end() && it->first == list[n])
+              {
+                edges.emplace_back(
+                  std::min(it->second, list[n + 1]), std::max(it->second, list[n + 1]));
+              }
+            }
+          }
+          std::sort(edges.begin(), edges.end());
+          edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
 
-  // Gather the small component graph on rank 0.
-  info.reserve(3 * roots.size());
-  for (int c : roots)
-  {
-    info.push_back(comps[c].Triangles);
-    info.push_back(comps[c].MinKey);
-    info.push_back(comps[c].Seeded ? 1 : 0);
-  }
-  for (const auto& e : edges)
-  {
-    flatEdges.push_back(e.first);
-    flatEdges.push_back(e.second);
-  }
-  for (int r = 0; r < ranks.Size; ++r)
-  {
-    infoLengths[r] = 3 * counts[r];
-    infoOffsets[r] = 3 * offsets[r];
-  }
-  allInfo.resize(ranks.Rank == 0 ? 3 * total + 1 : 1);
-      }))
+          // Gather the small component graph on rank 0.
+          info.reserve(3 * roots.size());
+          for (int c : roots)
+          {
+            info.push_back(comps[c].Triangles);
+            info.push_back(comps[c].MinKey);
+            info.push_back(comps[c].Seeded ? 1 : 0);
+          }
+          for (const auto& e : edges)
+          {
+            flatEdges.push_back(e.first);
+            flatEdges.push_back(e.second);
+          }
+          for (int r = 0; r < ranks.Size; ++r)
+          {
+            infoLengths[r] = 3 * counts[r];
+            infoOffsets[r] = 3 * offsets[r];
+          }
+          allInfo.resize(ranks.Rank == 0 ? 3 * total + 1 : 1);
+        }))
   {
     return false;
   }
@@ -443,92 +451,95 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
     edgeOffsets[r + 1] = edgeOffsets[r] + edgeLengths[r];
   }
   std::vector<vtkIdType> allEdges, finalIds;
-  if (!ranks.Step("join the components", problem, [&]() {
-        allEdges.resize(ranks.Rank == 0 ? edgeOffsets[ranks.Size] + 1 : 1);
-      }))
+  if (!ranks.Step("join the components", problem,
+        [&]() { allEdges.resize(ranks.Rank == 0 ? edgeOffsets[ranks.Size] + 1 : 1); }))
   {
     return false;
   }
-  ranks.Check(ranks.C->GatherV(flatEdges.data(), allEdges.data(), edgeLength,
-                edgeLengths.data(), edgeOffsets.data(), 0),
+  ranks.Check(ranks.C->GatherV(flatEdges.data(), allEdges.data(), edgeLength, edgeLengths.data(),
+                edgeOffsets.data(), 0),
     "gathering the component graph");
 
   vtkIdType totals[2] = { 0, 0 };
-  if (!ranks.Step("decide which components to keep", problem, [&]() {
-  finalIds.assign(ranks.Rank == 0 ? total + 1 : 1, -1);
-  if (ranks.Rank == 0)
-  {
-    std::vector<vtkIdType> parent(total);
-    std::iota(parent.begin(), parent.end(), 0);
-    auto find = [&parent](vtkIdType x) {
-      while (parent[x] != x)
-      {
-        x = parent[x] = parent[parent[x]];
-      }
-      return x;
-    };
-    for (vtkIdType n = 0; n + 1 < edgeOffsets[ranks.Size]; n += 2)
-    {
-      const vtkIdType a = find(allEdges[n]), b = find(allEdges[n + 1]);
-      if (a != b)
-      {
-        parent[std::max(a, b)] = std::min(a, b);
-      }
-    }
-    struct Class
-    {
-      vtkIdType Triangles = 0;
-      vtkIdType MinKey = std::numeric_limits<vtkIdType>::max();
-      bool Seeded = false;
-    };
-    std::vector<Class> classes(total);
-    for (vtkIdType c = 0; c < total; ++c)
-    {
-      Class& k = classes[find(c)];
-      k.Triangles += allInfo[3 * c];
-      k.MinKey = std::min(k.MinKey, allInfo[3 * c + 1]);
-      k.Seeded = k.Seeded || allInfo[3 * c + 2] != 0;
-    }
-    std::vector<vtkIdType> selected;
-    vtkIdType largest = -1;
-    for (vtkIdType c = 0; c < total; ++c)
-    {
-      if (find(c) != c || classes[c].Triangles == 0)
-      {
-        continue;
-      }
-      if (mode == vtkRGMarchingCubes::ALL_COMPONENTS ||
-        (mode == vtkRGMarchingCubes::SEEDED && classes[c].Seeded))
-      {
-        selected.push_back(c);
-      }
-      if (largest < 0 || classes[c].Triangles > classes[largest].Triangles ||
-        (classes[c].Triangles == classes[largest].Triangles &&
-          classes[c].MinKey < classes[largest].MinKey))
-      {
-        largest = c;
-      }
-    }
-    if (mode == vtkRGMarchingCubes::LARGEST_COMPONENT && largest >= 0)
-    {
-      selected.push_back(largest);
-    }
-    std::sort(selected.begin(), selected.end(),
-      [&classes](vtkIdType a, vtkIdType b) { return classes[a].MinKey < classes[b].MinKey; });
-    std::vector<vtkIdType> idOfClass(total, -1);
-    for (std::size_t n = 0; n < selected.size(); ++n)
-    {
-      idOfClass[selected[n]] = static_cast<vtkIdType>(n);
-      totals[0] += classes[selected[n]].Triangles;
-    }
-    totals[1] = static_cast<vtkIdType>(selected.size());
-    for (vtkIdType c = 0; c < total; ++c)
-    {
-      finalIds[c] = idOfClass[find(c)];
-    }
-  }
-  decision.FinalId.assign(static_cast<std::size_t>(localCount) + 1, -1);
-      }))
+  if (!ranks.Step("decide which components to keep", problem,
+        [&]()
+        {
+          finalIds.assign(ranks.Rank == 0 ? total + 1 : 1, -1);
+          if (ranks.Rank == 0)
+          {
+            std::vector<vtkIdType> parent(total);
+            std::iota(parent.begin(), parent.end(), 0);
+            auto find = [&parent](vtkIdType x)
+            {
+              while (parent[x] != x)
+              {
+                x = parent[x] = parent[parent[x]];
+              }
+              return x;
+            };
+            for (vtkIdType n = 0; n + 1 < edgeOffsets[ranks.Size]; n += 2)
+            {
+              const vtkIdType a = find(allEdges[n]), b = find(allEdges[n + 1]);
+              if (a != b)
+              {
+                parent[std::max(a, b)] = std::min(a, b);
+              }
+            }
+            struct Class
+            {
+              vtkIdType Triangles = 0;
+              vtkIdType MinKey = std::numeric_limits<vtkIdType>::max();
+              bool Seeded = false;
+            };
+            std::vector<Class> classes(total);
+            for (vtkIdType c = 0; c < total; ++c)
+            {
+              Class& k = classes[find(c)];
+              k.Triangles += allInfo[3 * c];
+              k.MinKey = std::min(k.MinKey, allInfo[3 * c + 1]);
+              k.Seeded = k.Seeded || allInfo[3 * c + 2] != 0;
+            }
+            std::vector<vtkIdType> selected;
+            vtkIdType largest = -1;
+            for (vtkIdType c = 0; c < total; ++c)
+            {
+              if (find(c) != c || classes[c].Triangles == 0)
+              {
+                continue;
+              }
+              if (mode == vtkRGMarchingCubes::ALL_COMPONENTS ||
+                (mode == vtkRGMarchingCubes::SEEDED && classes[c].Seeded))
+              {
+                selected.push_back(c);
+              }
+              if (largest < 0 || classes[c].Triangles > classes[largest].Triangles ||
+                (classes[c].Triangles == classes[largest].Triangles &&
+                  classes[c].MinKey < classes[largest].MinKey))
+              {
+                largest = c;
+              }
+            }
+            if (mode == vtkRGMarchingCubes::LARGEST_COMPONENT && largest >= 0)
+            {
+              selected.push_back(largest);
+            }
+            std::sort(selected.begin(), selected.end(),
+              [&classes](vtkIdType a, vtkIdType b)
+              { return classes[a].MinKey < classes[b].MinKey; });
+            std::vector<vtkIdType> idOfClass(total, -1);
+            for (std::size_t n = 0; n < selected.size(); ++n)
+            {
+              idOfClass[selected[n]] = static_cast<vtkIdType>(n);
+              totals[0] += classes[selected[n]].Triangles;
+            }
+            totals[1] = static_cast<vtkIdType>(selected.size());
+            for (vtkIdType c = 0; c < total; ++c)
+            {
+              finalIds[c] = idOfClass[find(c)];
+            }
+          }
+          decision.FinalId.assign(static_cast<std::size_t>(localCount) + 1, -1);
+        }))
   {
     return false;
   }
@@ -559,8 +570,8 @@ void GlobalRange(Ranks& ranks, vtkDataArray* scalars, double range[2])
     lo = r[0];
     hi = r[1];
   }
-  ranks.C->AllReduce(&lo, &range[0], 1, vtkCommunicator::MIN_OP);
-  ranks.C->AllReduce(&hi, &range[1], 1, vtkCommunicator::MAX_OP);
+  ranks.Check(ranks.C->AllReduce(&lo, &range[0], 1, vtkCommunicator::MIN_OP), "a reduction");
+  ranks.Check(ranks.C->AllReduce(&hi, &range[1], 1, vtkCommunicator::MAX_OP), "a reduction");
 }
 
 } // namespace
@@ -675,8 +686,8 @@ int vtkRGMarchingCubes::RequestData(
       }
     }
     int agreedLows[3], agreedHighs[3];
-    ranks.C->AllReduce(lows, agreedLows, 3, vtkCommunicator::MIN_OP);
-    ranks.C->AllReduce(highs, agreedHighs, 3, vtkCommunicator::MAX_OP);
+    ranks.Check(ranks.C->AllReduce(lows, agreedLows, 3, vtkCommunicator::MIN_OP), "a reduction");
+    ranks.Check(ranks.C->AllReduce(highs, agreedHighs, 3, vtkCommunicator::MAX_OP), "a reduction");
     if (agreedLows[0] <= agreedHighs[0])
     {
       for (int a = 0; a < 3; ++a)
@@ -774,7 +785,7 @@ int vtkRGMarchingCubes::RequestData(
   Geometry geom;
   {
     int mine = hasPoints ? ranks.Rank : ranks.Size, source = ranks.Size;
-    ranks.C->AllReduce(&mine, &source, 1, vtkCommunicator::MIN_OP);
+    ranks.Check(ranks.C->AllReduce(&mine, &source, 1, vtkCommunicator::MIN_OP), "a reduction");
     double g[15];
     if (ranks.Rank == source)
     {
@@ -783,7 +794,7 @@ int vtkRGMarchingCubes::RequestData(
       const double* d = input->GetDirectionMatrix()->GetData();
       std::copy_n(d, 9, g + 6);
     }
-    ranks.C->Broadcast(g, 15, source);
+    ranks.Check(ranks.C->Broadcast(g, 15, source), "a broadcast");
     std::copy_n(g, 3, geom.Origin);
     std::copy_n(g + 3, 3, geom.Spacing);
     std::copy_n(g + 6, 9, geom.Direction);
@@ -809,7 +820,7 @@ int vtkRGMarchingCubes::RequestData(
     const int mine[12] = { myCells.Lo[0], myCells.Lo[1], myCells.Lo[2], myCells.Hi[0],
       myCells.Hi[1], myCells.Hi[2], allMine.Lo[0], allMine.Lo[1], allMine.Lo[2], allMine.Hi[0],
       allMine.Hi[1], allMine.Hi[2] };
-    ranks.C->AllGather(mine, boxes.data(), 12);
+    ranks.Check(ranks.C->AllGather(mine, boxes.data(), 12), "a gather");
   }
   std::vector<rgmc::CellBox> cellBoxes(ranks.Size), extentBoxes(ranks.Size);
   for (int r = 0; r < ranks.Size; ++r)
@@ -856,7 +867,8 @@ int vtkRGMarchingCubes::RequestData(
   params.DoublePoints = this->OutputPointsPrecision == DOUBLE_PRECISION;
   geom.IndexToWorldMatrix(params.IndexToWorld);
   geom.NormalMatrix(params.NormalToWorld);
-  params.Progress = [this](double fraction) {
+  params.Progress = [this](double fraction)
+  {
     this->UpdateProgress(0.1 + 0.7 * fraction);
     return this->CheckAbort();
   };
@@ -912,9 +924,9 @@ int vtkRGMarchingCubes::RequestData(
         {
           msg << "seed point " << s << " (" << this->SeedPoints[3 * s] << ", "
               << this->SeedPoints[3 * s + 1] << ", " << this->SeedPoints[3 * s + 2]
-              << ") lies outside the volume, whose bounds are [" << bounds[0] << ", "
-              << bounds[1] << "] x [" << bounds[2] << ", " << bounds[3] << "] x [" << bounds[4]
-              << ", " << bounds[5] << "]";
+              << ") lies outside the volume, whose bounds are [" << bounds[0] << ", " << bounds[1]
+              << "] x [" << bounds[2] << ", " << bounds[3] << "] x [" << bounds[4] << ", "
+              << bounds[5] << "]";
           break;
         }
       }
@@ -941,7 +953,8 @@ int vtkRGMarchingCubes::RequestData(
       vtkErrorMacro(<< "Cannot extract a surface: " << error << ".");
       return 0;
     }
-    ranks.C->AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP);
+    ranks.Check(ranks.C->AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP),
+      "a reduction");
     std::vector<vtkIdType> keys(numSeeds), bestKeys(numSeeds);
     for (int s = 0; s < numSeeds; ++s)
     {
@@ -949,17 +962,20 @@ int vtkRGMarchingCubes::RequestData(
         ? hits[s].Key
         : std::numeric_limits<vtkIdType>::max();
     }
-    ranks.C->AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP);
+    ranks.Check(ranks.C->AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP),
+      "a reduction");
     std::vector<double> points(3 * numSeeds), bestPoints(3 * numSeeds);
     for (int s = 0; s < numSeeds; ++s)
     {
       for (int a = 0; a < 3; ++a)
       {
-        points[3 * s + a] = hits[s].Found && hits[s].Key == bestKeys[s] ? hits[s].Point[a]
-                                                                      : VTK_DOUBLE_MAX;
+        points[3 * s + a] =
+          hits[s].Found && hits[s].Key == bestKeys[s] ? hits[s].Point[a] : VTK_DOUBLE_MAX;
       }
     }
-    ranks.C->AllReduce(points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP);
+    ranks.Check(
+      ranks.C->AllReduce(points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP),
+      "a reduction");
     for (int s = 0; s < numSeeds; ++s)
     {
       if (bestKeys[s] == std::numeric_limits<vtkIdType>::max())
@@ -969,15 +985,14 @@ int vtkRGMarchingCubes::RequestData(
         std::ostringstream why;
         if (this->Isovalue > range[1] || this->Isovalue <= range[0])
         {
-          why << "the isovalue " << this->Isovalue << " is outside the data range ["
-              << range[0] << ", " << range[1] << "], so there is no surface at all";
+          why << "the isovalue " << this->Isovalue << " is outside the data range [" << range[0]
+              << ", " << range[1] << "], so there is no surface at all";
         }
         else
         {
           why << "no surface at isovalue " << this->Isovalue << " passes within "
-              << this->SeedSearchRadius << " of seed point " << s << " ("
-              << this->SeedPoints[3 * s] << ", " << this->SeedPoints[3 * s + 1] << ", "
-              << this->SeedPoints[3 * s + 2]
+              << this->SeedSearchRadius << " of seed point " << s << " (" << this->SeedPoints[3 * s]
+              << ", " << this->SeedPoints[3 * s + 1] << ", " << this->SeedPoints[3 * s + 2]
               << "); move the seed onto the structure or raise SeedSearchRadius";
         }
         vtkWarningMacro(<< "No surface extracted: " << why.str() << ".");
@@ -1054,93 +1069,98 @@ int vtkRGMarchingCubes::RequestData(
 
   // PASS 5: the output piece. The kernel's buffers become the output arrays without copies.
   output->Initialize();
-  if (!ranks.Step("store the surface", problem, [&]() {
-  rgmc::LocalMesh& mesh = grower.Mesh();
-  mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
-  const vtkIdType numPoints = mesh.NumberOfPoints();
-  const vtkIdType numKept = mesh.NumberOfTriangles();
-  for (std::int32_t& comp : mesh.TriangleComponent)
-  {
-    comp = static_cast<std::int32_t>(decision.FinalId[rootIndex[comp]]);
-  }
+  if (!ranks.Step("store the surface", problem,
+        [&]()
+        {
+          rgmc::LocalMesh& mesh = grower.Mesh();
+          mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
+          const vtkIdType numPoints = mesh.NumberOfPoints();
+          const vtkIdType numKept = mesh.NumberOfTriangles();
+          for (std::int32_t& comp : mesh.TriangleComponent)
+          {
+            comp = static_cast<std::int32_t>(decision.FinalId[rootIndex[comp]]);
+          }
 
-  vtkNew<vtkPoints> points;
-  if (this->OutputPointsPrecision == DOUBLE_PRECISION)
-  {
-    vtkNew<vtkDoubleArray> xyz;
-    xyz->SetNumberOfComponents(3);
-    xyz->SetArray(mesh.PointsDouble.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-    points->SetData(xyz);
-  }
-  else
-  {
-    vtkNew<vtkFloatArray> xyz;
-    xyz->SetNumberOfComponents(3);
-    xyz->SetArray(mesh.Points.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-    points->SetData(xyz);
-  }
-  vtkNew<vtkFloatArray> normals;
-  normals->SetName("Normals");
-  normals->SetNumberOfComponents(3);
-  if (this->ComputeNormals)
-  {
-    normals->SetArray(mesh.Normals.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-  }
-  vtkNew<vtkIdTypeArray> keys;
-  keys->SetName("VertexKey");
-  static_assert(sizeof(vtkIdType) == sizeof(long long), "vertex keys are 64-bit ids");
-  keys->SetArray(reinterpret_cast<vtkIdType*>(mesh.Keys.Release()), numPoints, 0,
-    vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+          vtkNew<vtkPoints> points;
+          if (this->OutputPointsPrecision == DOUBLE_PRECISION)
+          {
+            vtkNew<vtkDoubleArray> xyz;
+            xyz->SetNumberOfComponents(3);
+            xyz->SetArray(
+              mesh.PointsDouble.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+            points->SetData(xyz);
+          }
+          else
+          {
+            vtkNew<vtkFloatArray> xyz;
+            xyz->SetNumberOfComponents(3);
+            xyz->SetArray(
+              mesh.Points.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+            points->SetData(xyz);
+          }
+          vtkNew<vtkFloatArray> normals;
+          normals->SetName("Normals");
+          normals->SetNumberOfComponents(3);
+          if (this->ComputeNormals)
+          {
+            normals->SetArray(
+              mesh.Normals.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+          }
+          vtkNew<vtkIdTypeArray> keys;
+          keys->SetName("VertexKey");
+          static_assert(sizeof(vtkIdType) == sizeof(long long), "vertex keys are 64-bit ids");
+          keys->SetArray(reinterpret_cast<vtkIdType*>(mesh.Keys.Release()), numPoints, 0,
+            vtkAbstractArray::VTK_DATA_ARRAY_FREE);
 
-  // Triangles: the kernel's 32-bit connectivity, adopted as is; 64-bit when a rank has more
-  // than 2^31 - 1 corners, where 32-bit offsets would overflow.
-  vtkNew<vtkCellArray> polys;
-  if (3 * numKept <= VTK_TYPE_INT32_MAX)
-  {
-    vtkNew<vtkTypeInt32Array> offsets, connectivity;
-    std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-    for (vtkIdType n = 0; n <= numKept; ++n)
-    {
-      o[n] = static_cast<std::int32_t>(3 * n);
-    }
-    connectivity->SetArray(
-      mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-    polys->SetData(offsets, connectivity);
-  }
-  else
-  {
-    vtkNew<vtkTypeInt64Array> offsets, connectivity;
-    vtkTypeInt64* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-    for (vtkIdType n = 0; n <= numKept; ++n)
-    {
-      o[n] = 3 * n;
-    }
-    std::copy(mesh.Triangles.begin(), mesh.Triangles.begin() + 3 * numKept,
-      rgmc::Allocate(connectivity.Get(), 3 * numKept));
-    std::free(mesh.Triangles.Release());
-    polys->SetData(offsets, connectivity);
-  }
-  vtkNew<vtkIntArray> componentIds;
-  componentIds->SetName("ComponentId");
-  static_assert(sizeof(int) == sizeof(std::int32_t), "component ids are 32-bit");
-  componentIds->SetArray(reinterpret_cast<int*>(mesh.TriangleComponent.Release()), numKept, 0,
-    vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-  vtkNew<vtkIntArray> rankIds;
-  rankIds->SetName("RankId");
-  std::fill_n(rgmc::Allocate(rankIds.Get(), numKept), numKept, ranks.Rank);
+          // Triangles: the kernel's 32-bit connectivity, adopted as is; 64-bit when a rank has more
+          // than 2^31 - 1 corners, where 32-bit offsets would overflow.
+          vtkNew<vtkCellArray> polys;
+          if (3 * numKept <= VTK_TYPE_INT32_MAX)
+          {
+            vtkNew<vtkTypeInt32Array> offsets, connectivity;
+            std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
+            for (vtkIdType n = 0; n <= numKept; ++n)
+            {
+              o[n] = static_cast<std::int32_t>(3 * n);
+            }
+            connectivity->SetArray(
+              mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+            polys->SetData(offsets, connectivity);
+          }
+          else
+          {
+            vtkNew<vtkTypeInt64Array> offsets, connectivity;
+            vtkTypeInt64* o = rgmc::Allocate(offsets.Get(), numKept + 1);
+            for (vtkIdType n = 0; n <= numKept; ++n)
+            {
+              o[n] = 3 * n;
+            }
+            std::copy(mesh.Triangles.begin(), mesh.Triangles.begin() + 3 * numKept,
+              rgmc::Allocate(connectivity.Get(), 3 * numKept));
+            std::free(mesh.Triangles.Release());
+            polys->SetData(offsets, connectivity);
+          }
+          vtkNew<vtkIntArray> componentIds;
+          componentIds->SetName("ComponentId");
+          static_assert(sizeof(int) == sizeof(std::int32_t), "component ids are 32-bit");
+          componentIds->SetArray(reinterpret_cast<int*>(mesh.TriangleComponent.Release()), numKept,
+            0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+          vtkNew<vtkIntArray> rankIds;
+          rankIds->SetName("RankId");
+          std::fill_n(rgmc::Allocate(rankIds.Get(), numKept), numKept, ranks.Rank);
 
-  output->SetPoints(points);
-  output->SetPolys(polys);
-  if (this->ComputeNormals)
-  {
-    output->GetPointData()->SetNormals(normals);
-  }
-  output->GetPointData()->SetGlobalIds(keys);
-  output->GetCellData()->AddArray(rankIds);
-  // No active scalars: ParaView shows the surface in one colour, as Contour's; colouring by
-  // RankId (the decomposition) or ComponentId is the user's choice.
-  output->GetCellData()->AddArray(componentIds);
-      }))
+          output->SetPoints(points);
+          output->SetPolys(polys);
+          if (this->ComputeNormals)
+          {
+            output->GetPointData()->SetNormals(normals);
+          }
+          output->GetPointData()->SetGlobalIds(keys);
+          output->GetCellData()->AddArray(rankIds);
+          // No active scalars: ParaView shows the surface in one colour, as Contour's; colouring by
+          // RankId (the decomposition) or ComponentId is the user's choice.
+          output->GetCellData()->AddArray(componentIds);
+        }))
   {
     vtkErrorMacro(<< "Cannot extract a surface: " << problem << ".");
     output->Initialize();

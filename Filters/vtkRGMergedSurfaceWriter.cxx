@@ -214,10 +214,10 @@ std::size_t Base64(const char* data, std::size_t size, char* out)
   return static_cast<std::size_t>(out - start);
 }
 
-/// Text of fixed width: a number with its sign or a space, in scientific notation with all the digits its type
-/// needs to read back exactly (9 significant digits for float, 17 for double). Returns the
-/// length: 15 for float, 23 for double; anything else (not finite, or a double beyond 1e100)
-/// does not fit the file's fixed-width records.
+/// Text of fixed width: a number with its sign or a space, in scientific notation with all the
+/// digits its type needs to read back exactly (9 significant digits for float, 17 for double).
+/// Returns the length: 15 for float, 23 for double; anything else (not finite, or a double beyond
+/// 1e100) does not fit the file's fixed-width records.
 int FixedReal(char* out, double value, bool isDouble)
 {
   // A space, not '+', before positive numbers: VTK 9.3's PLY reader reads "+1.5" as 0.
@@ -337,13 +337,15 @@ struct ErrorCatcher
   explicit ErrorCatcher(vtkObject* object)
   {
     this->Command->SetClientData(this);
-    this->Command->SetCallback([](vtkObject*, unsigned long, void* self, void* text) {
-      auto* catcher = static_cast<ErrorCatcher*>(self);
-      if (catcher->Message.empty() && text)
+    this->Command->SetCallback(
+      [](vtkObject*, unsigned long, void* self, void* text)
       {
-        catcher->Message = static_cast<const char*>(text);
-      }
-    });
+        auto* catcher = static_cast<ErrorCatcher*>(self);
+        if (catcher->Message.empty() && text)
+        {
+          catcher->Message = static_cast<const char*>(text);
+        }
+      });
     object->AddObserver(vtkCommand::ErrorEvent, this->Command);
   }
 };
@@ -463,7 +465,8 @@ public:
           this->ArrayStart("Int64", "connectivity", 1, 24 * this->Triangles, this->Binary));
         this->TriangleBlock = this->L.Records(this->Triangles, triangle);
         // 8-byte offsets cannot be placed by byte range in base64: fixed-width text always.
-        this->L.Text("\n        </DataArray>\n" + this->ArrayStart("Int64", "offsets", 1, 0, false));
+        this->L.Text(
+          "\n        </DataArray>\n" + this->ArrayStart("Int64", "offsets", 1, 0, false));
         this->OffsetBlock = this->L.Records(this->Triangles, offset);
         this->L.Text(
           "        </DataArray>\n      </Polys>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
@@ -573,7 +576,8 @@ private:
       char* end = bytes;
       for (int k = 0; k < 3; ++k)
       {
-        end = isDouble ? PutLittleEndian(end, v[k]) : PutLittleEndian(end, static_cast<float>(v[k]));
+        end =
+          isDouble ? PutLittleEndian(end, v[k]) : PutLittleEndian(end, static_cast<float>(v[k]));
       }
       if (this->Kind == Format::VTP)
       {
@@ -643,7 +647,8 @@ private:
         return out - start;
       }
       char r[3][32];
-      auto reals = [&r](const double* values) {
+      auto reals = [&r](const double* values)
+      {
         for (int k = 0; k < 3; ++k)
         {
           if (FixedReal(r[k], values[k], false) != 15)
@@ -697,9 +702,10 @@ private:
       return static_cast<Int>(Base64(bytes, 24, out));
     }
     // Right-aligned with spaces, not zeros: VTK 9.3's PLY reader reads "010" as octal.
-    return std::sprintf(out, this->Kind == Format::PLY ? "3 %*lld %*lld %*lld\n" : "%*lld %*lld %*lld\n",
-      this->IdWidth, static_cast<long long>(g[0]), this->IdWidth, static_cast<long long>(g[1]),
-      this->IdWidth, static_cast<long long>(g[2]));
+    return std::sprintf(out,
+      this->Kind == Format::PLY ? "3 %*lld %*lld %*lld\n" : "%*lld %*lld %*lld\n", this->IdWidth,
+      static_cast<long long>(g[0]), this->IdWidth, static_cast<long long>(g[1]), this->IdWidth,
+      static_cast<long long>(g[2]));
   }
 
   // VTP's offset of triangle `index`: where its connectivity ends.
@@ -713,7 +719,8 @@ private:
   static std::string ArrayStart(
     const char* type, const char* name, int components, Int bytes, bool binary)
   {
-    std::string text = std::string("        <DataArray type=\"") + type + "\" Name=\"" + name + "\"";
+    std::string text =
+      std::string("        <DataArray type=\"") + type + "\" Name=\"" + name + "\"";
     if (components > 1)
     {
       text += " NumberOfComponents=\"" + std::to_string(components) + "\"";
@@ -787,7 +794,8 @@ void vtkRGMergedSurfaceWriter::WriteData()
   vtkNew<vtkDummyController> single;
   rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
   vtkPolyData* input = vtkPolyData::SafeDownCast(this->GetInput());
-  auto fail = [this](const std::string& problem) {
+  auto fail = [this](const std::string& problem)
+  {
     vtkErrorMacro(<< "Cannot write the surface: " << problem << ".");
     this->SetErrorCode(1);
   };
@@ -881,8 +889,7 @@ void vtkRGMergedSurfaceWriter::WriteData()
       triangles += all[3 * r + 1];
       normals = normals && all[3 * r + 2] == 0;
     }
-    const bool ready =
-      collected == Collected::Numbered && Placeable(mesh, vertices);
+    const bool ready = collected == Collected::Numbered && Placeable(mesh, vertices);
     if (!ranks.Any(!ready))
     {
       break;
@@ -912,8 +919,8 @@ void vtkRGMergedSurfaceWriter::WriteData()
   const Format format =
     extension == "stl" ? Format::STL : (extension == "ply" ? Format::PLY : Format::VTP);
   // The points' type is in the header: double when any rank has double points.
-  const bool doublePoints = ranks.Any(
-    format != Format::STL && mesh.Points && mesh.Points->GetDataType() == VTK_DOUBLE);
+  const bool doublePoints =
+    ranks.Any(format != Format::STL && mesh.Points && mesh.Points->GetDataType() == VTK_DOUBLE);
   MergedFile file(format, this->FileType != VTK_ASCII, mesh, vertices, triangles, firstTriangle,
     normals, doublePoints);
   problem = file.Limit();

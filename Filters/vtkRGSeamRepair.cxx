@@ -8,6 +8,7 @@
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 
+#include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDataSetAttributes.h"
@@ -29,17 +30,16 @@
 #include "vtkPolyData.h"
 #include "vtkTypeInt32Array.h"
 #include "vtkUnsignedCharArray.h"
-#include "vtkAOSDataArrayTemplate.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <functional>
-#include <type_traits>
-#include <array>
 #include <numeric>
 #include <queue>
 #include <sstream>
+#include <type_traits>
 #include <vector>
 
 vtkStandardNewMacro(vtkRGSeamRepair);
@@ -175,7 +175,7 @@ LocalVertices MergeLocal(
 /// ones.
 struct Numbering
 {
-  std::vector<vtkIdType> Gid;         // by vertex
+  std::vector<vtkIdType> Gid; // by vertex
   enum : unsigned char
   {
     Alone = 0,   // no other rank holds the vertex
@@ -226,42 +226,44 @@ bool Number(Ranks& ranks, const LocalVertices& local, std::vector<Identity<Words
   std::vector<Identity<Words>> splitters;
   std::vector<std::size_t> sliceStart(P + 1, n);
   std::vector<std::vector<vtkIdType>> outgoing(P);
-  if (!ranks.Step("send the vertex identities", problem, [&]() {
-        std::vector<Identity<Words>> sorted(static_cast<std::size_t>(offsets[P] / Words));
-        for (std::size_t s = 0; s < sorted.size(); ++s)
+  if (!ranks.Step("send the vertex identities", problem,
+        [&]()
         {
-          for (int k = 0; k < Words; ++k)
+          std::vector<Identity<Words>> sorted(static_cast<std::size_t>(offsets[P] / Words));
+          for (std::size_t s = 0; s < sorted.size(); ++s)
           {
-            sorted[s][k] = Unword(allSamples[Words * s + k]);
-          }
-        }
-        std::sort(sorted.begin(), sorted.end());
-        for (int h = 1; h < P && !sorted.empty(); ++h)
-        {
-          splitters.push_back(sorted[h * sorted.size() / P]);
-        }
-        // The ranges follow the sorted identities: rank h gets one slice of them.
-        sliceStart[0] = 0;
-        for (int h = 1; h <= P; ++h)
-        {
-          sliceStart[h] = h - 1 < static_cast<int>(splitters.size())
-            ? static_cast<std::size_t>(
-                std::upper_bound(ids.begin(), ids.end(), splitters[h - 1]) - ids.begin())
-            : n;
-        }
-        for (int h = 0; h < P; ++h)
-        {
-          outgoing[h].reserve(Words * (sliceStart[h + 1] - sliceStart[h]));
-          for (std::size_t i = sliceStart[h]; i < sliceStart[h + 1]; ++i)
-          {
-            for (std::uint64_t w : ids[i])
+            for (int k = 0; k < Words; ++k)
             {
-              outgoing[h].push_back(Word(w));
+              sorted[s][k] = Unword(allSamples[Words * s + k]);
             }
           }
-        }
-        std::vector<Identity<Words>>().swap(ids); // no longer needed
-      }))
+          std::sort(sorted.begin(), sorted.end());
+          for (int h = 1; h < P && !sorted.empty(); ++h)
+          {
+            splitters.push_back(sorted[h * sorted.size() / P]);
+          }
+          // The ranges follow the sorted identities: rank h gets one slice of them.
+          sliceStart[0] = 0;
+          for (int h = 1; h <= P; ++h)
+          {
+            sliceStart[h] = h - 1 < static_cast<int>(splitters.size())
+              ? static_cast<std::size_t>(
+                  std::upper_bound(ids.begin(), ids.end(), splitters[h - 1]) - ids.begin())
+              : n;
+          }
+          for (int h = 0; h < P; ++h)
+          {
+            outgoing[h].reserve(Words * (sliceStart[h + 1] - sliceStart[h]));
+            for (std::size_t i = sliceStart[h]; i < sliceStart[h + 1]; ++i)
+            {
+              for (std::uint64_t w : ids[i])
+              {
+                outgoing[h].push_back(Word(w));
+              }
+            }
+          }
+          std::vector<Identity<Words>>().swap(ids); // no longer needed
+        }))
   {
     return false;
   }
@@ -274,60 +276,64 @@ bool Number(Ranks& ranks, const LocalVertices& local, std::vector<Identity<Words
   // identities held by several ranks, (position, number of holders, holders...).
   std::vector<std::vector<vtkIdType>> answers(P);
   vtkIdType groups = 0;
-  if (!ranks.Step("number the vertex identities", problem, [&]() {
-        using Head = std::pair<Identity<Words>, int>; // identity, source
-        std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
-        std::vector<std::size_t> next(P, 0);
-        auto push = [&](int s) {
-          const std::vector<vtkIdType>& in = incoming[s];
-          if (next[s] + Words <= in.size())
+  if (!ranks.Step("number the vertex identities", problem,
+        [&]()
+        {
+          using Head = std::pair<Identity<Words>, int>; // identity, source
+          std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
+          std::vector<std::size_t> next(P, 0);
+          auto push = [&](int s)
           {
-            Identity<Words> id;
-            for (int k = 0; k < Words; ++k)
+            const std::vector<vtkIdType>& in = incoming[s];
+            if (next[s] + Words <= in.size())
             {
-              id[k] = Unword(in[next[s] + k]);
+              Identity<Words> id;
+              for (int k = 0; k < Words; ++k)
+              {
+                id[k] = Unword(in[next[s] + k]);
+              }
+              heads.emplace(id, s);
             }
-            heads.emplace(id, s);
-          }
-        };
-        for (int s = 0; s < P; ++s)
-        {
-          answers[s].reserve(incoming[s].size() / Words);
-          push(s);
-        }
-        std::vector<std::vector<vtkIdType>> sharedRecords(P);
-        std::vector<int> holders; // sources of the current group, in increasing order
-        while (!heads.empty())
-        {
-          const Identity<Words> id = heads.top().first;
-          holders.clear();
-          while (!heads.empty() && heads.top().first == id)
+          };
+          for (int s = 0; s < P; ++s)
           {
-            const int s = heads.top().second;
-            heads.pop();
-            holders.push_back(s);
-            answers[s].push_back(groups);
-            next[s] += Words;
+            answers[s].reserve(incoming[s].size() / Words);
             push(s);
           }
-          if (holders.size() > 1)
+          std::vector<std::vector<vtkIdType>> sharedRecords(P);
+          std::vector<int> holders; // sources of the current group, in increasing order
+          while (!heads.empty())
           {
-            for (int s : holders)
+            const Identity<Words> id = heads.top().first;
+            holders.clear();
+            while (!heads.empty() && heads.top().first == id)
             {
-              std::vector<vtkIdType>& out = sharedRecords[s];
-              out.insert(out.end(), { static_cast<vtkIdType>(next[s] / Words - 1),
-                                      static_cast<vtkIdType>(holders.size()) });
-              out.insert(out.end(), holders.begin(), holders.end());
+              const int s = heads.top().second;
+              heads.pop();
+              holders.push_back(s);
+              answers[s].push_back(groups);
+              next[s] += Words;
+              push(s);
             }
+            if (holders.size() > 1)
+            {
+              for (int s : holders)
+              {
+                std::vector<vtkIdType>& out = sharedRecords[s];
+                out.insert(out.end(),
+                  { static_cast<vtkIdType>(next[s] / Words - 1),
+                    static_cast<vtkIdType>(holders.size()) });
+                out.insert(out.end(), holders.begin(), holders.end());
+              }
+            }
+            ++groups;
           }
-          ++groups;
-        }
-        std::vector<std::vector<vtkIdType>>().swap(incoming);
-        for (int s = 0; s < P; ++s)
-        {
-          answers[s].insert(answers[s].end(), sharedRecords[s].begin(), sharedRecords[s].end());
-        }
-      }))
+          std::vector<std::vector<vtkIdType>>().swap(incoming);
+          for (int s = 0; s < P; ++s)
+          {
+            answers[s].insert(answers[s].end(), sharedRecords[s].begin(), sharedRecords[s].end());
+          }
+        }))
   {
     return false;
   }
@@ -341,41 +347,43 @@ bool Number(Ranks& ranks, const LocalVertices& local, std::vector<Identity<Words
   // identity the sender sent here).
   auto replies = ranks.Exchange(answers, everyone, AnswerTag);
   std::vector<std::vector<vtkIdType>>().swap(answers);
-  return ranks.Step("number the vertices", problem, [&]() {
-    numbering.Total = first[P];
-    numbering.Gid.resize(static_cast<std::size_t>(local.Count));
-    numbering.Holding.assign(static_cast<std::size_t>(local.Count), Numbering::Alone);
-    for (int h = 0; h < P; ++h)
+  return ranks.Step("number the vertices", problem,
+    [&]()
     {
-      const std::vector<vtkIdType>& in = replies[h];
-      const std::size_t sent = sliceStart[h + 1] - sliceStart[h];
-      for (std::size_t i = 0; i < sent; ++i)
+      numbering.Total = first[P];
+      numbering.Gid.resize(static_cast<std::size_t>(local.Count));
+      numbering.Holding.assign(static_cast<std::size_t>(local.Count), Numbering::Alone);
+      for (int h = 0; h < P; ++h)
       {
-        numbering.Gid[local.Sorted[sliceStart[h] + i]] = first[h] + in[i];
-      }
-      // Shared identities, in increasing position: the shared vertices come in gid order.
-      for (std::size_t i = sent; i + 1 < in.size();)
-      {
-        const vtkIdType v = local.Sorted[sliceStart[h] + static_cast<std::size_t>(in[i])];
-        const vtkIdType holders = in[i + 1];
-        const int owner = static_cast<int>(in[i + 2]);
-        numbering.SharedVertex.push_back(v);
-        numbering.SharedOwner.push_back(owner);
-        numbering.Holding[v] =
-          owner != ranks.Rank ? Numbering::Shared | Numbering::Foreign : Numbering::Shared;
-        for (vtkIdType j = 0; j < holders; ++j)
+        const std::vector<vtkIdType>& in = replies[h];
+        const std::size_t sent = sliceStart[h + 1] - sliceStart[h];
+        for (std::size_t i = 0; i < sent; ++i)
         {
-          const int holder = static_cast<int>(in[i + 2 + j]);
-          if (holder != ranks.Rank)
-          {
-            numbering.Sharers.push_back(holder);
-          }
+          numbering.Gid[local.Sorted[sliceStart[h] + i]] = first[h] + in[i];
         }
-        numbering.SharerOffsets.push_back(static_cast<vtkIdType>(numbering.Sharers.size()));
-        i += 2 + static_cast<std::size_t>(holders);
+        // Shared identities, in increasing position: the shared vertices come in gid order.
+        for (std::size_t i = sent; i + 1 < in.size();)
+        {
+          const vtkIdType v = local.Sorted[sliceStart[h] + static_cast<std::size_t>(in[i])];
+          const vtkIdType holders = in[i + 1];
+          const int owner = static_cast<int>(in[i + 2]);
+          numbering.SharedVertex.push_back(v);
+          numbering.SharedOwner.push_back(owner);
+          numbering.Holding[v] =
+            owner != ranks.Rank ? Numbering::Shared | Numbering::Foreign : Numbering::Shared;
+          for (vtkIdType j = 0; j < holders; ++j)
+          {
+            const int holder = static_cast<int>(in[i + 2 + j]);
+            if (holder != ranks.Rank)
+            {
+              numbering.Sharers.push_back(holder);
+            }
+          }
+          numbering.SharerOffsets.push_back(static_cast<vtkIdType>(numbering.Sharers.size()));
+          i += 2 + static_cast<std::size_t>(holders);
+        }
       }
-    }
-  });
+    });
 }
 
 // ---- the mesh around each owned vertex ---------------------------------------------------------
@@ -475,7 +483,8 @@ public:
     // The corners of the triangles at each vertex, in compressed rows.
     std::vector<vtkIdType> cornerOffsets, corners;
     // The ends of this rank's edges at vertex v (once per triangle side), sorted by gid.
-    auto localEnds = [&](vtkIdType v) {
+    auto localEnds = [&](vtkIdType v)
+    {
       ends.clear();
       for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
       {
@@ -489,7 +498,8 @@ public:
       std::sort(ends.begin(), ends.end());
     };
     // This rank's edges at vertex v, sorted by the neighbour's gid, into `out`.
-    auto localNeighbours = [&](vtkIdType v, std::vector<Neighbour>& out) {
+    auto localNeighbours = [&](vtkIdType v, std::vector<Neighbour>& out)
+    {
       localEnds(v);
       for (std::size_t e = 0; e < ends.size();)
       {
@@ -498,8 +508,8 @@ public:
         {
           ++end;
         }
-        out.push_back(Neighbour{ ends[e].first, static_cast<int>(end - e), ends[e].second, me, 0,
-          { 0, 0, 0 } });
+        out.push_back(Neighbour{
+          ends[e].first, static_cast<int>(end - e), ends[e].second, me, 0, { 0, 0, 0 } });
         e = end;
       }
     };
@@ -507,45 +517,46 @@ public:
     // Edges at shared vertices go to their owners (shared vertices in gid order: each owner
     // receives them in its own order).
     std::vector<std::vector<vtkIdType>> outgoing(P);
-    if (!this->R.Step("list the edges at the seams", problem, [&]() {
-          cornerOffsets.assign(static_cast<std::size_t>(this->N) + 1, 0);
-          for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
+    if (!this->R.Step("list the edges at the seams", problem,
+          [&]()
           {
-            ++cornerOffsets[static_cast<vtkIdType>(this->Triangles[c]) + 1];
-          }
-          for (vtkIdType v = 0; v < this->N; ++v)
-          {
-            cornerOffsets[v + 1] += cornerOffsets[v];
-          }
-          corners.resize(static_cast<std::size_t>(3 * this->NumTriangles));
-          std::vector<vtkIdType> fill(cornerOffsets.begin(), cornerOffsets.end() - 1);
-          for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
-          {
-            corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = c;
-          }
-          for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
-          {
-            const int owner = this->Num.SharedOwner[i];
-            if (owner == me)
+            cornerOffsets.assign(static_cast<std::size_t>(this->N) + 1, 0);
+            for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
             {
-              continue;
+              ++cornerOffsets[static_cast<vtkIdType>(this->Triangles[c]) + 1];
             }
-            const vtkIdType v = this->Num.SharedVertex[i];
-            all.clear();
-            localNeighbours(v, all);
-            std::vector<vtkIdType>& out = outgoing[owner];
-            out.push_back(gid[v]);
-            out.push_back(static_cast<vtkIdType>(all.size()));
-            for (const Neighbour& nb : all)
+            for (vtkIdType v = 0; v < this->N; ++v)
             {
-              const T* x = this->X + 3 * nb.Local;
-              out.insert(out.end(), { nb.Gid, nb.Uses, this->MaskOf(nb.Local),
-                                      PackDouble(static_cast<double>(x[0])),
-                                      PackDouble(static_cast<double>(x[1])),
-                                      PackDouble(static_cast<double>(x[2])) });
+              cornerOffsets[v + 1] += cornerOffsets[v];
             }
-          }
-        }))
+            corners.resize(static_cast<std::size_t>(3 * this->NumTriangles));
+            std::vector<vtkIdType> fill(cornerOffsets.begin(), cornerOffsets.end() - 1);
+            for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
+            {
+              corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = c;
+            }
+            for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
+            {
+              const int owner = this->Num.SharedOwner[i];
+              if (owner == me)
+              {
+                continue;
+              }
+              const vtkIdType v = this->Num.SharedVertex[i];
+              all.clear();
+              localNeighbours(v, all);
+              std::vector<vtkIdType>& out = outgoing[owner];
+              out.push_back(gid[v]);
+              out.push_back(static_cast<vtkIdType>(all.size()));
+              for (const Neighbour& nb : all)
+              {
+                const T* x = this->X + 3 * nb.Local;
+                out.insert(out.end(),
+                  { nb.Gid, nb.Uses, this->MaskOf(nb.Local), PackDouble(static_cast<double>(x[0])),
+                    PackDouble(static_cast<double>(x[1])), PackDouble(static_cast<double>(x[2])) });
+              }
+            }
+          }))
     {
       return false;
     }
@@ -560,20 +571,23 @@ public:
       double X[3];
     };
     std::vector<Pending> pending;
-    if (!this->R.Step("make the smoothing stencils", problem, [&]() {
-          std::vector<std::size_t> cursor(P, 0);
-          std::vector<rgmc::IncidentEdge> incident;
-          std::vector<std::int64_t> stencil;
-          const double cosEdgeAngle = std::cos(vtkMath::RadiansFromDegrees(15.0));
-          if (stencils)
+    if (!this->R.Step("make the smoothing stencils", problem,
+          [&]()
           {
-            this->Owned.reserve(static_cast<std::size_t>(this->N));
-            this->Stencil.Offsets.reserve(static_cast<std::size_t>(this->N) + 1);
-            this->Stencil.Neighbours.reserve(static_cast<std::size_t>(3 * this->NumTriangles));
-          }
-          // Any vertex: its whole neighbourhood (with the edges other ranks sent, for a shared
-          // one), the checks, its stencil.
-          auto general = [&](vtkIdType v, bool isShared, std::size_t sharedIndex) {
+            std::vector<std::size_t> cursor(P, 0);
+            std::vector<rgmc::IncidentEdge> incident;
+            std::vector<std::int64_t> stencil;
+            const double cosEdgeAngle = std::cos(vtkMath::RadiansFromDegrees(15.0));
+            if (stencils)
+            {
+              this->Owned.reserve(static_cast<std::size_t>(this->N));
+              this->Stencil.Offsets.reserve(static_cast<std::size_t>(this->N) + 1);
+              this->Stencil.Neighbours.reserve(static_cast<std::size_t>(3 * this->NumTriangles));
+            }
+            // Any vertex: its whole neighbourhood (with the edges other ranks sent, for a shared
+            // one), the checks, its stencil.
+            auto general = [&](vtkIdType v, bool isShared, std::size_t sharedIndex)
+            {
               all.clear();
               localNeighbours(v, all);
               if (isShared)
@@ -643,11 +657,13 @@ public:
               {
                 return;
               }
-              auto find = [&all](vtkIdType g) -> const Neighbour& {
+              auto find = [&all](vtkIdType g) -> const Neighbour&
+              {
                 return *std::lower_bound(all.begin(), all.end(), g,
                   [](const Neighbour& nb, vtkIdType key) { return nb.Gid < key; });
               };
-              auto position = [&](const Neighbour& nb, T x[3]) {
+              auto position = [&](const Neighbour& nb, T x[3])
+              {
                 for (int k = 0; k < 3; ++k)
                 {
                   x[k] = nb.Local >= 0 ? this->X[3 * nb.Local + k] : static_cast<T>(nb.X[k]);
@@ -655,7 +671,8 @@ public:
               };
               rgmc::SmoothingStencil(
                 incident,
-                [&](std::int64_t a, std::int64_t b) {
+                [&](std::int64_t a, std::int64_t b)
+                {
                   T pa[3], pb[3];
                   position(find(a), pa);
                   position(find(b), pb);
@@ -676,114 +693,116 @@ public:
               }
               this->Stencil.Offsets.push_back(
                 static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
-          };
-          // Vertices no other rank holds, in memory order: most are inside a closed manifold
-          // piece of the surface, where every edge has two triangles and the stencil is simply
-          // the neighbours in gid order.
-          for (vtkIdType v = 0; v < this->N; ++v)
-          {
-            if (this->Num.Holding[v] != Numbering::Alone)
+            };
+            // Vertices no other rank holds, in memory order: most are inside a closed manifold
+            // piece of the surface, where every edge has two triangles and the stencil is simply
+            // the neighbours in gid order.
+            for (vtkIdType v = 0; v < this->N; ++v)
             {
-              continue;
-            }
-            localEnds(v);
-            bool manifold = !ends.empty() && ends.size() < 2 * 255;
-            for (std::size_t e = 0; e < ends.size() && manifold; e += 2)
-            {
-              manifold = e + 1 < ends.size() && ends[e + 1].first == ends[e].first &&
-                (e + 2 == ends.size() || ends[e + 2].first != ends[e].first);
-            }
-            if (!manifold)
-            {
-              general(v, false, 0);
-              continue;
-            }
-            for (std::size_t e = 0; e < ends.size(); e += 2)
-            {
-              checks.Edges += ends[e].first > gid[v];
-            }
-            if (stencils)
-            {
-              this->Owned.push_back(v);
+              if (this->Num.Holding[v] != Numbering::Alone)
+              {
+                continue;
+              }
+              localEnds(v);
+              bool manifold = !ends.empty() && ends.size() < 2 * 255;
+              for (std::size_t e = 0; e < ends.size() && manifold; e += 2)
+              {
+                manifold = e + 1 < ends.size() && ends[e + 1].first == ends[e].first &&
+                  (e + 2 == ends.size() || ends[e + 2].first != ends[e].first);
+              }
+              if (!manifold)
+              {
+                general(v, false, 0);
+                continue;
+              }
               for (std::size_t e = 0; e < ends.size(); e += 2)
               {
-                this->Stencil.Neighbours.push_back(ends[e].second);
+                checks.Edges += ends[e].first > gid[v];
               }
-              this->Stencil.Offsets.push_back(
-                static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
-            }
-          }
-          // Shared vertices this rank owns, in gid order (the order of the received edges).
-          for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
-          {
-            if (this->Num.SharedOwner[i] == me)
-            {
-              general(this->Num.SharedVertex[i], true, i);
-            }
-          }
-          std::vector<vtkIdType>().swap(corners);
-          std::vector<vtkIdType>().swap(cornerOffsets);
-
-          // The neighbours held elsewhere get slots N, N + 1, ... in gid order.
-          std::vector<vtkIdType> order(pending.size()), slotOf(pending.size());
-          std::iota(order.begin(), order.end(), vtkIdType(0));
-          std::sort(order.begin(), order.end(),
-            [&pending](vtkIdType a, vtkIdType b) { return pending[a].Gid < pending[b].Gid; });
-          for (vtkIdType o : order)
-          {
-            const Pending& p = pending[o];
-            if (this->RemoteGids.empty() || this->RemoteGids.back() != p.Gid)
-            {
-              this->RemoteGids.push_back(p.Gid);
-              this->RemoteProviders.push_back(p.Provider);
-              this->RemoteInitial.insert(this->RemoteInitial.end(), p.X, p.X + 3);
-            }
-            slotOf[o] = static_cast<vtkIdType>(this->RemoteGids.size()) - 1;
-          }
-          for (std::int64_t& s : this->Stencil.Neighbours)
-          {
-            s = s < 0 ? this->N + slotOf[-1 - s] : s;
-          }
-          // Who sends what each iteration: the neighbours owners lack, from ranks that hold
-          // them; the owners' new positions, to the other holders (both sides list a pair's
-          // vertices in gid order).
-          for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
-          {
-            this->RequestLists[this->RemoteProviders[r]].push_back(this->RemoteGids[r]);
-            this->RemoteOrder[this->RemoteProviders[r]].push_back(
-              this->N + static_cast<vtkIdType>(r));
-          }
-          for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
-          {
-            const vtkIdType v = this->Num.SharedVertex[i];
-            if (this->Num.SharedOwner[i] == me)
-            {
-              for (vtkIdType h = this->Num.SharerOffsets[i]; h < this->Num.SharerOffsets[i + 1];
-                   ++h)
+              if (stencils)
               {
-                this->ToSharer[this->Num.Sharers[h]].push_back(v);
+                this->Owned.push_back(v);
+                for (std::size_t e = 0; e < ends.size(); e += 2)
+                {
+                  this->Stencil.Neighbours.push_back(ends[e].second);
+                }
+                this->Stencil.Offsets.push_back(
+                  static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
               }
             }
-            else
+            // Shared vertices this rank owns, in gid order (the order of the received edges).
+            for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
             {
-              this->FromOwner[this->Num.SharedOwner[i]].push_back(v);
+              if (this->Num.SharedOwner[i] == me)
+              {
+                general(this->Num.SharedVertex[i], true, i);
+              }
             }
-          }
-        }))
+            std::vector<vtkIdType>().swap(corners);
+            std::vector<vtkIdType>().swap(cornerOffsets);
+
+            // The neighbours held elsewhere get slots N, N + 1, ... in gid order.
+            std::vector<vtkIdType> order(pending.size()), slotOf(pending.size());
+            std::iota(order.begin(), order.end(), vtkIdType(0));
+            std::sort(order.begin(), order.end(),
+              [&pending](vtkIdType a, vtkIdType b) { return pending[a].Gid < pending[b].Gid; });
+            for (vtkIdType o : order)
+            {
+              const Pending& p = pending[o];
+              if (this->RemoteGids.empty() || this->RemoteGids.back() != p.Gid)
+              {
+                this->RemoteGids.push_back(p.Gid);
+                this->RemoteProviders.push_back(p.Provider);
+                this->RemoteInitial.insert(this->RemoteInitial.end(), p.X, p.X + 3);
+              }
+              slotOf[o] = static_cast<vtkIdType>(this->RemoteGids.size()) - 1;
+            }
+            for (std::int64_t& s : this->Stencil.Neighbours)
+            {
+              s = s < 0 ? this->N + slotOf[-1 - s] : s;
+            }
+            // Who sends what each iteration: the neighbours owners lack, from ranks that hold
+            // them; the owners' new positions, to the other holders (both sides list a pair's
+            // vertices in gid order).
+            for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
+            {
+              this->RequestLists[this->RemoteProviders[r]].push_back(this->RemoteGids[r]);
+              this->RemoteOrder[this->RemoteProviders[r]].push_back(
+                this->N + static_cast<vtkIdType>(r));
+            }
+            for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
+            {
+              const vtkIdType v = this->Num.SharedVertex[i];
+              if (this->Num.SharedOwner[i] == me)
+              {
+                for (vtkIdType h = this->Num.SharerOffsets[i]; h < this->Num.SharerOffsets[i + 1];
+                     ++h)
+                {
+                  this->ToSharer[this->Num.Sharers[h]].push_back(v);
+                }
+              }
+              else
+              {
+                this->FromOwner[this->Num.SharedOwner[i]].push_back(v);
+              }
+            }
+          }))
     {
       return false;
     }
     const auto asked = this->R.Exchange(this->RequestLists, this->Partners, RequestTag);
     std::vector<std::vector<vtkIdType>>().swap(this->RequestLists);
-    return this->R.Step("plan the smoothing's exchanges", problem, [&]() {
-      for (int s = 0; s < P; ++s)
+    return this->R.Step("plan the smoothing's exchanges", problem,
+      [&]()
       {
-        for (vtkIdType g : asked[s])
+        for (int s = 0; s < P; ++s)
         {
-          this->Provide[s].push_back(this->VertexOfGid(g));
+          for (vtkIdType g : asked[s])
+          {
+            this->Provide[s].push_back(this->VertexOfGid(g));
+          }
         }
-      }
-    });
+      });
   }
 
   /// Smooths the positions into Smoothed. Returns false when aborted or failed (with
@@ -795,24 +814,26 @@ public:
     std::vector<T> a, b, c, sum;
     std::vector<double> coefficients;
     const bool sinc = method == vtkRGSeamRepair::WINDOWED_SINC;
-    if (!this->R.Step("smooth the surface", problem, [&]() {
-          a.resize(size);
-          b.resize(size);
-          std::copy(this->X, this->X + 3 * this->N, a.begin());
-          for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
+    if (!this->R.Step("smooth the surface", problem,
+          [&]()
           {
-            for (int k = 0; k < 3; ++k)
+            a.resize(size);
+            b.resize(size);
+            std::copy(this->X, this->X + 3 * this->N, a.begin());
+            for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
             {
-              a[3 * (this->N + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
+              for (int k = 0; k < 3; ++k)
+              {
+                a[3 * (this->N + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
+              }
             }
-          }
-          if (sinc)
-          {
-            c.resize(size);
-            sum.resize(size);
-            coefficients = rgmc::SincCoefficients(iterations, passBand, window);
-          }
-        }))
+            if (sinc)
+            {
+              c.resize(size);
+              sum.resize(size);
+              coefficients = rgmc::SincCoefficients(iterations, passBand, window);
+            }
+          }))
     {
       return false;
     }
@@ -874,64 +895,68 @@ public:
   {
     std::vector<double> n;
     std::vector<std::vector<double>> partial(this->R.Size);
-    if (!this->R.Step("compute normals", problem, [&]() {
-          n.assign(3 * this->N, 0.0);
-          const T* x = this->Smoothed.data();
-          for (vtkIdType t = 0; t < this->NumTriangles; ++t)
+    if (!this->R.Step("compute normals", problem,
+          [&]()
           {
-            const vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
-              static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
-              static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
-            double e1[3], e2[3], cross[3];
-            for (int k = 0; k < 3; ++k)
+            n.assign(3 * this->N, 0.0);
+            const T* x = this->Smoothed.data();
+            for (vtkIdType t = 0; t < this->NumTriangles; ++t)
             {
-              e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
-              e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
-            }
-            vtkMath::Cross(e1, e2, cross);
-            for (int k = 0; k < 3; ++k)
-            {
-              for (int corner = 0; corner < 3; ++corner)
+              const vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
+                static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
+                static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
+              double e1[3], e2[3], cross[3];
+              for (int k = 0; k < 3; ++k)
               {
-                n[3 * c[corner] + k] += cross[k];
+                e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
+                e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
+              }
+              vtkMath::Cross(e1, e2, cross);
+              for (int k = 0; k < 3; ++k)
+              {
+                for (int corner = 0; corner < 3; ++corner)
+                {
+                  n[3 * c[corner] + k] += cross[k];
+                }
               }
             }
-          }
-          // Partial sums of shared vertices to their owners, added in rank order; results back.
-          for (int o = 0; o < this->R.Size; ++o)
-          {
-            for (vtkIdType v : this->FromOwner[o])
+            // Partial sums of shared vertices to their owners, added in rank order; results back.
+            for (int o = 0; o < this->R.Size; ++o)
             {
-              partial[o].insert(partial[o].end(), &n[3 * v], &n[3 * v] + 3);
+              for (vtkIdType v : this->FromOwner[o])
+              {
+                partial[o].insert(partial[o].end(), &n[3 * v], &n[3 * v] + 3);
+              }
             }
-          }
-        }))
+          }))
     {
       return {};
     }
     const auto sums = this->R.Exchange(partial, this->Partners, NormalTag);
     std::vector<float> normals;
-    if (!this->R.Step("compute normals", problem, [&]() {
-          for (int s = 0; s < this->R.Size; ++s)
+    if (!this->R.Step("compute normals", problem,
+          [&]()
           {
-            if (s == this->R.Rank)
+            for (int s = 0; s < this->R.Size; ++s)
             {
-              continue;
-            }
-            const std::vector<vtkIdType>& list = this->ToSharer[s];
-            for (std::size_t i = 0; i < list.size() && 3 * i + 2 < sums[s].size(); ++i)
-            {
-              for (int k = 0; k < 3; ++k)
+              if (s == this->R.Rank)
               {
-                n[3 * list[i] + k] += sums[s][3 * i + k];
+                continue;
+              }
+              const std::vector<vtkIdType>& list = this->ToSharer[s];
+              for (std::size_t i = 0; i < list.size() && 3 * i + 2 < sums[s].size(); ++i)
+              {
+                for (int k = 0; k < 3; ++k)
+                {
+                  n[3 * list[i] + k] += sums[s][3 * i + k];
+                }
               }
             }
-          }
-          for (vtkIdType v = 0; v < this->N; ++v)
-          {
-            vtkMath::Normalize(&n[3 * v]);
-          }
-        }))
+            for (vtkIdType v = 0; v < this->N; ++v)
+            {
+              vtkMath::Normalize(&n[3 * v]);
+            }
+          }))
     {
       return {};
     }
@@ -1036,10 +1061,10 @@ private:
   std::vector<vtkIdType> RemoteGids; // neighbours of owned vertices held elsewhere, by slot
   std::vector<int> RemoteProviders;
   std::vector<double> RemoteInitial;
-  std::vector<std::vector<vtkIdType>> ToSharer;    // holder -> owned shared vertices
-  std::vector<std::vector<vtkIdType>> FromOwner;   // owner -> vertices it updates here
-  std::vector<std::vector<vtkIdType>> Provide;     // requester -> vertices to send
-  std::vector<std::vector<vtkIdType>> RemoteOrder; // provider -> slots, in request order
+  std::vector<std::vector<vtkIdType>> ToSharer;     // holder -> owned shared vertices
+  std::vector<std::vector<vtkIdType>> FromOwner;    // owner -> vertices it updates here
+  std::vector<std::vector<vtkIdType>> Provide;      // requester -> vertices to send
+  std::vector<std::vector<vtkIdType>> RemoteOrder;  // provider -> slots, in request order
   std::vector<std::vector<vtkIdType>> RequestLists; // provider -> gids asked of it
 };
 
@@ -1118,7 +1143,8 @@ int vtkRGSeamRepair::RequestData(
   const vtkIdType* keys = allKeyed && keyArray ? keyArray->GetPointer(0) : nullptr;
   LocalVertices local;
   Numbering numbering;
-  auto number = [&](auto words) {
+  auto number = [&](auto words)
+  {
     constexpr int Words = decltype(words)::value;
     std::vector<Identity<Words>> ids;
     return ranks.Step("sort the vertices", problem,
@@ -1168,68 +1194,72 @@ int vtkRGSeamRepair::RequestData(
   // PASS 2-4: edges at the seams, checks, smoothing, normals; in the input points' precision,
   // over the input's own connectivity when no points were merged.
   const bool smooth = this->SmoothingMethod != NO_SMOOTHING && this->NumberOfIterations > 0;
-  const bool doublePoints =
-    input->GetPoints() && input->GetPoints()->GetDataType() == VTK_DOUBLE;
+  const bool doublePoints = input->GetPoints() && input->GetPoints()->GetDataType() == VTK_DOUBLE;
   vtkDataArray* inputConnectivity = input->GetPolys()->GetConnectivityArray();
   std::vector<vtkIdType> connectivityCopy; // when the input's cannot be used as it is
   vtkNew<vtkPoints> points;
   std::vector<float> normals;
   Checks checks;
   bool aborted = false;
-  auto progress = [this, &ranks](double fraction) {
+  auto progress = [this, &ranks](double fraction)
+  {
     this->UpdateProgress(0.4 + 0.5 * fraction);
     return ranks.Any(this->CheckAbort());
   };
-  auto run = [&](auto pointType, auto indexType) -> bool {
+  auto run = [&](auto pointType, auto indexType) -> bool
+  {
     using T = decltype(pointType);
     using I = decltype(indexType);
     const T* x = nullptr;
     std::vector<T> xCopy;
     const I* tris = nullptr;
-    if (!ranks.Step("copy the input", problem, [&]() {
-          using PointArray = vtkAOSDataArrayTemplate<T>;
-          PointArray* inputPoints =
-            input->GetPoints() ? PointArray::FastDownCast(input->GetPoints()->GetData()) : nullptr;
-          if (inputPoints && !local.Merged())
+    if (!ranks.Step("copy the input", problem,
+          [&]()
           {
-            x = inputPoints->GetPointer(0);
-          }
-          else
-          {
-            xCopy.resize(static_cast<std::size_t>(3 * local.Count));
-            for (vtkIdType v = 0; v < local.Count; ++v)
+            using PointArray = vtkAOSDataArrayTemplate<T>;
+            PointArray* inputPoints = input->GetPoints()
+              ? PointArray::FastDownCast(input->GetPoints()->GetData())
+              : nullptr;
+            if (inputPoints && !local.Merged())
             {
-              double p[3];
-              input->GetPoint(local.PointOf(v), p);
-              for (int k = 0; k < 3; ++k)
-              {
-                xCopy[3 * v + k] = static_cast<T>(p[k]);
-              }
+              x = inputPoints->GetPointer(0);
             }
-            x = xCopy.data();
-          }
-          using IndexArray = vtkAOSDataArrayTemplate<I>;
-          IndexArray* typed = IndexArray::FastDownCast(inputConnectivity);
-          if (typed && !local.Merged())
-          {
-            tris = typed->GetPointer(0); // every cell is a triangle (PASS 0)
-          }
-          else if constexpr (std::is_same<I, vtkIdType>::value)
-          {
-            connectivityCopy.reserve(static_cast<std::size_t>(3 * input->GetNumberOfPolys()));
-            vtkCellArray* polys = input->GetPolys();
-            vtkIdType npts;
-            const vtkIdType* pts;
-            for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+            else
             {
-              for (int k = 0; k < 3; ++k)
+              xCopy.resize(static_cast<std::size_t>(3 * local.Count));
+              for (vtkIdType v = 0; v < local.Count; ++v)
               {
-                connectivityCopy.push_back(local.VertexOf(pts[k]));
+                double p[3];
+                input->GetPoint(local.PointOf(v), p);
+                for (int k = 0; k < 3; ++k)
+                {
+                  xCopy[3 * v + k] = static_cast<T>(p[k]);
+                }
               }
+              x = xCopy.data();
             }
-            tris = connectivityCopy.data();
-          }
-        }))
+            using IndexArray = vtkAOSDataArrayTemplate<I>;
+            IndexArray* typed = IndexArray::FastDownCast(inputConnectivity);
+            if (typed && !local.Merged())
+            {
+              tris = typed->GetPointer(0); // every cell is a triangle (PASS 0)
+            }
+            else if constexpr (std::is_same<I, vtkIdType>::value)
+            {
+              connectivityCopy.reserve(static_cast<std::size_t>(3 * input->GetNumberOfPolys()));
+              vtkCellArray* polys = input->GetPolys();
+              vtkIdType npts;
+              const vtkIdType* pts;
+              for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+              {
+                for (int k = 0; k < 3; ++k)
+                {
+                  connectivityCopy.push_back(local.VertexOf(pts[k]));
+                }
+              }
+              tris = connectivityCopy.data();
+            }
+          }))
     {
       return false;
     }
@@ -1257,18 +1287,21 @@ int vtkRGSeamRepair::RequestData(
       }
     }
     // The output's points: the input's own when nothing moved and nothing was merged.
-    return ranks.Step("store the output points", problem, [&]() {
-      const std::vector<T>& moved = smooth ? repair.Smoothed : xCopy;
-      if (!smooth && !local.Merged())
+    return ranks.Step("store the output points", problem,
+      [&]()
       {
-        points->ShallowCopy(input->GetPoints());
-        return;
-      }
-      vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
-      xyz->SetNumberOfComponents(3);
-      std::copy(moved.begin(), moved.begin() + 3 * local.Count, rgmc::Allocate(xyz.Get(), 3 * local.Count));
-      points->SetData(xyz);
-    });
+        const std::vector<T>& moved = smooth ? repair.Smoothed : xCopy;
+        if (!smooth && !local.Merged())
+        {
+          points->ShallowCopy(input->GetPoints());
+          return;
+        }
+        vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
+        xyz->SetNumberOfComponents(3);
+        std::copy(moved.begin(), moved.begin() + 3 * local.Count,
+          rgmc::Allocate(xyz.Get(), 3 * local.Count));
+        points->SetData(xyz);
+      });
   };
   // A connectivity copy is always 64-bit; the input's own may be 32-bit.
   const bool int32 = !local.Merged() && vtkTypeInt32Array::FastDownCast(inputConnectivity);
@@ -1304,61 +1337,65 @@ int vtkRGSeamRepair::RequestData(
   // were), global ids, duplicate flags, smoothed points and their normals.
   const vtkIdType n = local.Count;
   output->Initialize();
-  if (!ranks.Step("build the output", problem, [&]() {
-        output->SetPoints(points);
-        vtkPointData* pd = output->GetPointData();
-        pd->CopyGlobalIdsOff();
-        if (smooth)
+  if (!ranks.Step("build the output", problem,
+        [&]()
         {
-          pd->CopyNormalsOff();
-        }
-        if (!local.Merged())
-        {
-          output->SetPolys(input->GetPolys());
-          pd->PassData(input->GetPointData());
-        }
-        else
-        {
-          vtkNew<vtkIdTypeArray> offsets, conn;
-          const vtkIdType numTris = static_cast<vtkIdType>(connectivityCopy.size() / 3);
-          vtkIdType* o = rgmc::Allocate(offsets.Get(), numTris + 1);
-          for (vtkIdType t = 0; t <= numTris; ++t)
+          output->SetPoints(points);
+          vtkPointData* pd = output->GetPointData();
+          pd->CopyGlobalIdsOff();
+          if (smooth)
           {
-            o[t] = 3 * t;
+            pd->CopyNormalsOff();
           }
-          std::copy(connectivityCopy.begin(), connectivityCopy.end(),
-            rgmc::Allocate(conn.Get(), static_cast<vtkIdType>(connectivityCopy.size())));
-          vtkNew<vtkCellArray> polys;
-          polys->SetData(offsets, conn);
-          output->SetPolys(polys);
-          pd->CopyAllocate(input->GetPointData(), n);
+          if (!local.Merged())
+          {
+            output->SetPolys(input->GetPolys());
+            pd->PassData(input->GetPointData());
+          }
+          else
+          {
+            vtkNew<vtkIdTypeArray> offsets, conn;
+            const vtkIdType numTris = static_cast<vtkIdType>(connectivityCopy.size() / 3);
+            vtkIdType* o = rgmc::Allocate(offsets.Get(), numTris + 1);
+            for (vtkIdType t = 0; t <= numTris; ++t)
+            {
+              o[t] = 3 * t;
+            }
+            std::copy(connectivityCopy.begin(), connectivityCopy.end(),
+              rgmc::Allocate(conn.Get(), static_cast<vtkIdType>(connectivityCopy.size())));
+            vtkNew<vtkCellArray> polys;
+            polys->SetData(offsets, conn);
+            output->SetPolys(polys);
+            pd->CopyAllocate(input->GetPointData(), n);
+            for (vtkIdType v = 0; v < n; ++v)
+            {
+              pd->CopyData(input->GetPointData(), local.PointOf(v), v);
+            }
+          }
+          output->GetCellData()->PassData(input->GetCellData());
+          vtkNew<vtkIdTypeArray> gids;
+          gids->SetName("GlobalPointIds");
+          vtkNew<vtkUnsignedCharArray> ghosts;
+          ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+          std::copy(numbering.Gid.begin(), numbering.Gid.end(), rgmc::Allocate(gids.Get(), n));
+          unsigned char* ghost = rgmc::Allocate(ghosts.Get(), n);
           for (vtkIdType v = 0; v < n; ++v)
           {
-            pd->CopyData(input->GetPointData(), local.PointOf(v), v);
+            ghost[v] = (numbering.Holding[v] & Numbering::Foreign)
+              ? vtkDataSetAttributes::DUPLICATEPOINT
+              : 0;
           }
-        }
-        output->GetCellData()->PassData(input->GetCellData());
-        vtkNew<vtkIdTypeArray> gids;
-        gids->SetName("GlobalPointIds");
-        vtkNew<vtkUnsignedCharArray> ghosts;
-        ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-        std::copy(numbering.Gid.begin(), numbering.Gid.end(), rgmc::Allocate(gids.Get(), n));
-        unsigned char* ghost = rgmc::Allocate(ghosts.Get(), n);
-        for (vtkIdType v = 0; v < n; ++v)
-        {
-          ghost[v] = (numbering.Holding[v] & Numbering::Foreign) ? vtkDataSetAttributes::DUPLICATEPOINT : 0;
-        }
-        pd->SetGlobalIds(gids);
-        pd->AddArray(ghosts);
-        if (smooth)
-        {
-          vtkNew<vtkFloatArray> normalArray;
-          normalArray->SetName("Normals");
-          normalArray->SetNumberOfComponents(3);
-          std::copy(normals.begin(), normals.end(), rgmc::Allocate(normalArray.Get(), 3 * n));
-          pd->SetNormals(normalArray);
-        }
-      }))
+          pd->SetGlobalIds(gids);
+          pd->AddArray(ghosts);
+          if (smooth)
+          {
+            vtkNew<vtkFloatArray> normalArray;
+            normalArray->SetName("Normals");
+            normalArray->SetNumberOfComponents(3);
+            std::copy(normals.begin(), normals.end(), rgmc::Allocate(normalArray.Get(), 3 * n));
+            pd->SetNormals(normalArray);
+          }
+        }))
   {
     vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
     output->Initialize();
@@ -1367,7 +1404,8 @@ int vtkRGSeamRepair::RequestData(
 
   vtkFieldData* fd = output->GetFieldData();
   fd->PassData(input->GetFieldData());
-  auto add = [fd](const char* name, vtkIdType value) {
+  auto add = [fd](const char* name, vtkIdType value)
+  {
     vtkNew<vtkIdTypeArray> a;
     a->SetName(name);
     a->InsertNextValue(value);
@@ -1403,7 +1441,8 @@ void vtkRGSeamRepair::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfIterations: " << this->NumberOfIterations << "\n";
   os << indent << "RelaxationFactor: " << this->RelaxationFactor << "\n";
   os << indent << "PassBand: " << this->PassBand << "\n";
-  os << indent << "WindowFunction: " << (this->WindowFunction == HAMMING_WINDOW ? "Hamming" : "Nuttall")
+  os << indent
+     << "WindowFunction: " << (this->WindowFunction == HAMMING_WINDOW ? "Hamming" : "Nuttall")
      << "\n";
   os << indent << "Controller: " << this->Controller << "\n";
 }

@@ -162,7 +162,8 @@ struct LocalMesh
     {
       buffer->resize_down(buffer->empty() ? 0 : 3 * static_cast<std::size_t>(next));
     }
-    this->PointsDouble.resize_down(this->PointsDouble.empty() ? 0 : 3 * static_cast<std::size_t>(next));
+    this->PointsDouble.resize_down(
+      this->PointsDouble.empty() ? 0 : 3 * static_cast<std::size_t>(next));
     this->Keys.resize_down(next);
     this->VertexComponent.resize_down(next);
   }
@@ -174,8 +175,8 @@ class Grower
 public:
   using ValueType = typename std::decay<decltype(std::declval<const Values&>()[0])>::type;
 
-  Grower(const CaseTable& table, const Grid& grid, const Ownership& ownership,
-    const Values& values, const GrowerParams& params)
+  Grower(const CaseTable& table, const Grid& grid, const Ownership& ownership, const Values& values,
+    const GrowerParams& params)
     : Table(table)
     , G(grid)
     , Own(ownership)
@@ -263,8 +264,8 @@ public:
   /// `seedWorld` the same point in world coordinates. Only vertices within `radius` count.
   /// `minStep` is a lower bound of the world length of any index step of length 1 (the
   /// smallest singular value of direction * spacing); it bounds the search shells.
-  SeedHit NearestVertex(const double seedIndex[3], const double seedWorld[3], double radius,
-    double minStep)
+  SeedHit NearestVertex(
+    const double seedIndex[3], const double seedWorld[3], double radius, double minStep)
   {
     SeedHit best;
     if (this->Own.OwnsNothing())
@@ -279,7 +280,8 @@ public:
       c[a] = std::max(this->G.WholeLo[a], std::min(this->G.WholeHi[a] - 1, c[a]));
     }
     const double radius2 = radius * radius;
-    auto consider = [&](std::int64_t key, const double x[3]) {
+    auto consider = [&](std::int64_t key, const double x[3])
+    {
       const double d2 = Distance2(x, seedWorld);
       if (d2 <= radius2 && (d2 < best.Distance2 || (d2 == best.Distance2 && key < best.Key)))
       {
@@ -312,38 +314,40 @@ public:
       const CellBox clip = shell.Intersect(box);
       if (!clip.Empty())
       {
-        this->ForShell(clip, c, r, [&](int i, int j, int k) {
-          if (this->Stopped() || !this->Own.Owns(i, j, k) || !this->Evaluate(i, j, k, st) ||
-            st.Case == 0 || st.Case == 255)
+        this->ForShell(clip, c, r,
+          [&](int i, int j, int k)
           {
-            return;
-          }
-          double x[3];
-          if (!st.Degenerate)
-          {
-            unsigned edges = this->Table[st.Case].CutEdges;
-            while (edges)
+            if (this->Stopped() || !this->Own.Owns(i, j, k) || !this->Evaluate(i, j, k, st) ||
+              st.Case == 0 || st.Case == 255)
             {
-              const int e = __builtin_ctz(edges);
-              edges &= edges - 1;
-              int p[3];
-              this->EdgeLowPoint(i, j, k, e, p);
-              this->EdgePosition(p, this->EdgeAxisOf[e], st.S[EdgeCorners[e][0]],
-                st.S[EdgeCorners[e][1]], x);
-              consider(this->G.EdgeKey(p[0], p[1], p[2], this->EdgeAxisOf[e]), x);
+              return;
             }
-            return;
-          }
-          this->ComputeGroups(i, j, k, st, groups);
-          for (int t = 0; t < groups.NumTriangles; ++t)
-          {
-            for (int v = 0; v < 3; ++v)
+            double x[3];
+            if (!st.Degenerate)
             {
-              this->KeyPosition(groups.Keys[t][v], groups.Edges[t][v], st, x);
-              consider(groups.Keys[t][v], x);
+              unsigned edges = this->Table[st.Case].CutEdges;
+              while (edges)
+              {
+                const int e = __builtin_ctz(edges);
+                edges &= edges - 1;
+                int p[3];
+                this->EdgeLowPoint(i, j, k, e, p);
+                this->EdgePosition(
+                  p, this->EdgeAxisOf[e], st.S[EdgeCorners[e][0]], st.S[EdgeCorners[e][1]], x);
+                consider(this->G.EdgeKey(p[0], p[1], p[2], this->EdgeAxisOf[e]), x);
+              }
+              return;
             }
-          }
-        });
+            this->ComputeGroups(i, j, k, st, groups);
+            for (int t = 0; t < groups.NumTriangles; ++t)
+            {
+              for (int v = 0; v < 3; ++v)
+              {
+                this->KeyPosition(groups.Keys[t][v], groups.Edges[t][v], st, x);
+                consider(groups.Keys[t][v], x);
+              }
+            }
+          });
       }
       if (shell.ContainsBox(box) || this->Stopped())
       {
@@ -403,8 +407,7 @@ public:
     {
       for (int side = 0; side < 2 && !this->Stopped(); ++side)
       {
-        const bool neighbourExists =
-          side == 0 ? box.Lo[a] > whole.Lo[a] : box.Hi[a] < whole.Hi[a];
+        const bool neighbourExists = side == 0 ? box.Lo[a] > whole.Lo[a] : box.Hi[a] < whole.Hi[a];
         if (neighbourExists)
         {
           this->GrowFromPlane(a, side == 0 ? box.Lo[a] : box.Hi[a] + 1);
@@ -493,7 +496,8 @@ public:
     // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,
     // z edges inside it. The top plane becomes the next slab's bottom.
     this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
-    const std::size_t planeSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
+    const std::size_t planeSize =
+      static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
     for (auto& layer : this->Layers)
     {
       layer.Ids.Allocate(planeSize);
@@ -501,7 +505,7 @@ public:
     }
     Layer* bottom[2] = { &this->Layers[0], &this->Layers[1] }; // x, y edges at z = k
     Layer* top[2] = { &this->Layers[2], &this->Layers[3] };    // x, y edges at z = k + 1
-    Layer* vertical = &this->Layers[4];                          // z edges
+    Layer* vertical = &this->Layers[4];                        // z edges
     for (int s = 0; s < numSlabs && !this->Stopped(); ++s)
     {
       const int k = box.Lo[2] + s;
@@ -699,7 +703,8 @@ private:
     {
       parent[t] = t;
     }
-    auto find = [&parent](int x) {
+    auto find = [&parent](int x)
+    {
       while (parent[x] != x)
       {
         x = parent[x];
@@ -796,9 +801,12 @@ private:
       // Central differences on all axes, the samples at hand: the common case.
       const std::int64_t at = this->G.LocalIndex(i, j, k);
       const std::int64_t sy = this->G.StrideY, sz = this->G.StrideZ;
-      n[0] = 0.5 * (static_cast<double>(this->Vals[at - 1]) - static_cast<double>(this->Vals[at + 1]));
-      n[1] = 0.5 * (static_cast<double>(this->Vals[at - sy]) - static_cast<double>(this->Vals[at + sy]));
-      n[2] = 0.5 * (static_cast<double>(this->Vals[at - sz]) - static_cast<double>(this->Vals[at + sz]));
+      n[0] =
+        0.5 * (static_cast<double>(this->Vals[at - 1]) - static_cast<double>(this->Vals[at + 1]));
+      n[1] =
+        0.5 * (static_cast<double>(this->Vals[at - sy]) - static_cast<double>(this->Vals[at + sy]));
+      n[2] =
+        0.5 * (static_cast<double>(this->Vals[at - sz]) - static_cast<double>(this->Vals[at + sz]));
       if (std::is_integral<ValueType>::value || (n[0] == n[0] && n[1] == n[1] && n[2] == n[2]))
       {
         return;
@@ -896,8 +904,8 @@ private:
 
   /// Marks node (cube, group) found and appends it to the node list (the queue). Cubes with one
   /// node use only the bit per cube; cubes with several remember which nodes were taken.
-  void Mark(int i, int j, int k, std::int64_t bit, const CubeState& st, int group, int numGroups,
-    int comp)
+  void Mark(
+    int i, int j, int k, std::int64_t bit, const CubeState& st, int group, int numGroups, int comp)
   {
     if (numGroups == 1)
     {
@@ -1192,8 +1200,8 @@ private:
   // ---- phase 2 internals ---------------------------------------------------------------------
 
   /// Creates the output point of a vertex: position, normal, component, port check.
-  std::int32_t NewVertex(std::int64_t key, const int p[3], int axis, double sLo, double sHi,
-    int comp)
+  std::int32_t NewVertex(
+    std::int64_t key, const int p[3], int axis, double sLo, double sHi, int comp)
   {
     double x[3];
     float normal[3] = { 0, 0, 0 };
@@ -1259,8 +1267,8 @@ private:
 
   /// The output point of a vertex met by component `comp`, whose id + 1 is kept in `slot` (0:
   /// none yet): made on first use; met again by another component, it joins the two.
-  std::int32_t UseVertex(std::int32_t& slot, std::int64_t key, const int p[3], int axis,
-    double sLo, double sHi, int comp, Layer* layer, std::int32_t index)
+  std::int32_t UseVertex(std::int32_t& slot, std::int64_t key, const int p[3], int axis, double sLo,
+    double sHi, int comp, Layer* layer, std::int32_t index)
   {
     if (slot > 0)
     {
@@ -1415,7 +1423,7 @@ private:
   static constexpr int TileCubes = 32;  // cubes along each axis of a tile of visited bits
   static constexpr int TileWords = 512; // 64-bit words in a tile
   std::int64_t Tiles[3] = { 0, 0, 0 };  // tiles along each axis of the owned box
-  ZeroedArray<std::uint64_t> Visited; // a bit per owned cube: its nodes were all found
+  ZeroedArray<std::uint64_t> Visited;   // a bit per owned cube: its nodes were all found
   KeyMap MultiGroup{ 64 };
   std::vector<Node> Nodes;
   std::int64_t NodesExpanded = 0;

@@ -36,9 +36,9 @@
 namespace
 {
 
-constexpr int Whole = 4096;            // points per axis of the whole extent
-constexpr int CornerLo = Whole - 16;   // the corner block: points CornerLo .. Whole - 1
-const double Center = Whole - 8.5;     // a sphere of radius 5 in it
+constexpr int Whole = 4096;          // points per axis of the whole extent
+constexpr int CornerLo = Whole - 16; // the corner block: points CornerLo .. Whole - 1
+const double Center = Whole - 8.5;   // a sphere of radius 5 in it
 
 double Field(int i, int j, int k)
 {
@@ -58,7 +58,8 @@ public:
 
 protected:
   CornerSource() { this->SetNumberOfInputPorts(0); }
-  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override
+  int RequestInformation(
+    vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override
   {
     const int whole[6] = { 0, Whole - 1, 0, Whole - 1, 0, Whole - 1 };
     out->GetInformationObject(0)->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
@@ -187,8 +188,9 @@ int main(int argc, char* argv[])
     const std::vector<Triangle> got = Gathered(controller, surface);
     if (rank == 0)
     {
-      RGMC_CHECK(got == expected, name << ": " << got.size() << " triangles at the far corner, "
-                                       << expected.size() << " in a volume of their own, or they differ");
+      RGMC_CHECK(got == expected,
+        name << ": " << got.size() << " triangles at the far corner, " << expected.size()
+             << " in a volume of their own, or they differ");
     }
 
     // Keys beyond 32 bits that decode to the edge (or grid point) the vertex lies on.
@@ -210,7 +212,8 @@ int main(int argc, char* argv[])
         wrong += a == axis ? !(x[a] >= g[a] && x[a] <= g[a] + 1) : x[a] != g[a];
       }
     }
-    RGMC_CHECK(small32 == 0, name << ": " << small32 << " vertex keys below 2^32 at the far corner");
+    RGMC_CHECK(
+      small32 == 0, name << ": " << small32 << " vertex keys below 2^32 at the far corner");
     RGMC_CHECK(wrong == 0, name << ": " << wrong << " coordinates off the edge their key names");
 
     // Seam Repair: the same vertices; one closed surface; global ids 0..N-1.
@@ -223,15 +226,17 @@ int main(int argc, char* argv[])
     const vtkIdType unique = FieldValue(repaired, "UniquePoints");
     RGMC_CHECK(unique == FieldValue(smallRepair->GetOutput(), "UniquePoints") &&
         FieldValue(repaired, "Closed") == 1,
-      name << ": " << unique << " unique points (" << FieldValue(smallRepair->GetOutput(), "UniquePoints")
-           << " expected), closed " << FieldValue(repaired, "Closed"));
+      name << ": " << unique << " unique points ("
+           << FieldValue(smallRepair->GetOutput(), "UniquePoints") << " expected), closed "
+           << FieldValue(repaired, "Closed"));
     vtkIdTypeArray* gids = vtkIdTypeArray::SafeDownCast(repaired->GetPointData()->GetGlobalIds());
     vtkIdType outOfRange = 0;
     for (vtkIdType p = 0; gids && p < gids->GetNumberOfValues(); ++p)
     {
       outOfRange += gids->GetValue(p) < 0 || gids->GetValue(p) >= unique;
     }
-    RGMC_CHECK(gids && outOfRange == 0, name << ": " << outOfRange << " global ids out of 0.." << unique - 1);
+    RGMC_CHECK(gids && outOfRange == 0,
+      name << ": " << outOfRange << " global ids out of 0.." << unique - 1);
 
     // The merged writer: one PLY read back by VTK's reader.
     const std::string file = "TestFarCorner-" + std::to_string(ranks) + ".ply";
@@ -248,8 +253,9 @@ int main(int argc, char* argv[])
       reader->Update();
       RGMC_CHECK(reader->GetOutput()->GetNumberOfPoints() == unique &&
           Triangles(reader->GetOutput()) == expected,
-        name << ": the PLY file has " << reader->GetOutput()->GetNumberOfPoints() << " vertices and "
-             << reader->GetOutput()->GetNumberOfPolys() << " triangles, or other triangles");
+        name << ": the PLY file has " << reader->GetOutput()->GetNumberOfPoints()
+             << " vertices and " << reader->GetOutput()->GetNumberOfPolys()
+             << " triangles, or other triangles");
       ::unlink(file.c_str());
     }
     if (rank == 0)

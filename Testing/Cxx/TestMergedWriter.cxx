@@ -105,8 +105,8 @@ struct Written
   std::string Errors;
 };
 
-Written Write(vtkMultiProcessController* controller, vtkPolyData* surface, const std::string& path,
-  int type)
+Written Write(
+  vtkMultiProcessController* controller, vtkPolyData* surface, const std::string& path, int type)
 {
   vtkNew<vtkRGMergedSurfaceWriter> writer;
   vtkNew<MessageCatcher> catcher;
@@ -183,8 +183,8 @@ void Compare(vtkPolyData* read, vtkPolyData* reference, bool pointsInOrder, bool
       }
     }
     RGMC_CHECK(differ == 0, what << ": " << differ << " vertices differ from the 1-rank mesh's");
-    RGMC_CHECK(
-      normalsDiffer == 0, what << ": " << normalsDiffer << " normals differ from the 1-rank mesh's");
+    RGMC_CHECK(normalsDiffer == 0,
+      what << ": " << normalsDiffer << " normals differ from the 1-rank mesh's");
   }
   RGMC_CHECK(read->GetNumberOfPolys() == reference->GetNumberOfPolys(),
     what << ": " << read->GetNumberOfPolys() << " triangles, the 1-rank mesh has "
@@ -318,8 +318,8 @@ int main(int argc, char* argv[])
   {
     vtkSmartPointer<vtkImageData> image =
       MakePiece(Skull, Whole, PieceOf("block", Whole, rank, ranks));
-    vtkSmartPointer<vtkPolyData> repaired = Repair(controller,
-      Extract(controller, image, 400, vtkRGMarchingCubes::SEEDED, seeds).Output);
+    vtkSmartPointer<vtkPolyData> repaired =
+      Repair(controller, Extract(controller, image, 400, vtkRGMarchingCubes::SEEDED, seeds).Output);
     const std::string path = dir + "/skull.pvtp";
     const Written w = Write(controller, repaired, path, VTK_BINARY);
     RGMC_CHECK(w.Ok && w.Errors.empty(), "pvtp: " << w.Errors);
@@ -334,7 +334,9 @@ int main(int argc, char* argv[])
     }
 
     // Errors, the same on every rank, and no file left behind.
-    auto expectError = [&](const std::string& file, const std::string& text, const std::string& what) {
+    auto expectError = [&](
+                         const std::string& file, const std::string& text, const std::string& what)
+    {
       const Written e = Write(controller, repaired, file, VTK_BINARY);
       RGMC_CHECK(!e.Ok, what << ": no error");
       RGMC_CHECK(e.Errors.find(text) != std::string::npos,
@@ -343,7 +345,8 @@ int main(int argc, char* argv[])
         SameOnAllRanks(controller, Message(e.Errors)), what << ": the ranks' messages differ");
     };
     expectError(dir + "/no-such-directory/skull.stl", "cannot create", "a missing directory");
-    expectError(dir + "/skull.obj", "must end in .stl, .ply, .vtp or .pvtp", "an unknown extension");
+    expectError(
+      dir + "/skull.obj", "must end in .stl, .ply, .vtp or .pvtp", "an unknown extension");
 
     // The last rank's disk is full: a file size limit below its records (its writes fail with
     // EFBIG instead of the signal, which the test ignores).
@@ -367,7 +370,8 @@ int main(int argc, char* argv[])
     RGMC_CHECK(e.Errors.find("cannot write") != std::string::npos &&
         e.Errors.find("File too large") != std::string::npos,
       "a full disk (rank " << rank << "): the error does not name it: " << e.Errors);
-    RGMC_CHECK(SameOnAllRanks(controller, Message(e.Errors)), "a full disk: the ranks' messages differ");
+    RGMC_CHECK(
+      SameOnAllRanks(controller, Message(e.Errors)), "a full disk: the ranks' messages differ");
     controller->Barrier();
     RGMC_CHECK(!Exists(full), "a full disk: the incomplete file is still there");
   }

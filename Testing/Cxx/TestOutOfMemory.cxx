@@ -6,8 +6,8 @@
 // For each stage in turn, the limit is set when the stage starts, from just above the memory in
 // use to more than the stage needs, so that allocations fail at different points of each stage
 // (the test prints which stage failed at each limit, and requires a failure in every stage and a
-// complete run once the limit is high enough). Not built with the sanitizers: AddressSanitizer reserves
-// terabytes of address space, so an address-space limit cannot work there.
+// complete run once the limit is high enough). Not built with the sanitizers: AddressSanitizer
+// reserves terabytes of address space, so an address-space limit cannot work there.
 #include "rgmcCheck.h"
 #include "rgmcDistributedData.h" // SameOnAllRanks
 #include "rgmcTestController.h"
@@ -69,7 +69,8 @@ Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const st
   const bool limited = controller->GetLocalProcessId() == ranks - 1;
   struct rlimit saved;
   ::getrlimit(RLIMIT_AS, &saved);
-  auto limit = [&](int stage) {
+  auto limit = [&](int stage)
+  {
     if (limited && stage == limitStage)
     {
       struct rlimit l = saved;
@@ -90,12 +91,14 @@ Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const st
     }
   } restore{ limited, saved };
   Run run;
-  auto agreed = [&](rgmc_test::MessageCatcher* catcher, int stage) {
+  auto agreed = [&](rgmc_test::MessageCatcher* catcher, int stage)
+  {
     // Either every rank failed or none did; the errors must say why.
     int failed = catcher->Errors.empty() ? 0 : 1, sum = 0;
     controller->AllReduce(&failed, &sum, 1, vtkCommunicator::SUM_OP);
     RGMC_CHECK(sum == 0 || sum == ranks,
-      "stage " << stage << " failed on " << sum << " of " << ranks << " ranks: " << catcher->Errors);
+      "stage " << stage << " failed on " << sum << " of " << ranks
+               << " ranks: " << catcher->Errors);
     if (sum > 0)
     {
       run.FailedStage = stage;
@@ -134,7 +137,8 @@ Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const st
   {
     return run;
   }
-  auto count = [&](const char* name) {
+  auto count = [&](const char* name)
+  {
     vtkIdTypeArray* a =
       vtkIdTypeArray::SafeDownCast(repair->GetOutput()->GetFieldData()->GetArray(name));
     return a ? static_cast<long long>(a->GetValue(0)) : -1LL;
@@ -178,8 +182,9 @@ int main(int argc, char* argv[])
   split->PieceToExtentThreadSafe(
     rank, ranks, 1, const_cast<int*>(whole), ghosted, vtkExtentTranslator::BLOCK_MODE, 0);
   const double w = 2.0 * M_PI / 12.0;
-  vtkSmartPointer<vtkImageData> volume =
-    rgmc_test::MakeImage(ghosted, VTK_FLOAT, [w](int i, int j, int k) {
+  vtkSmartPointer<vtkImageData> volume = rgmc_test::MakeImage(ghosted, VTK_FLOAT,
+    [w](int i, int j, int k)
+    {
       const double x = w * (i + 0.25), y = w * (j + 0.5), z = w * (k + 0.125);
       return std::sin(x) * std::cos(y) + std::sin(y) * std::cos(z) + std::sin(z) * std::cos(x);
     });
@@ -228,8 +233,8 @@ int main(int argc, char* argv[])
         "stage " << run.FailedStage << " failed before the limit was set");
       if (run.FailedStage == 0)
       {
-        RGMC_CHECK(run.Triangles == reference.Triangles &&
-            run.UniquePoints == reference.UniquePoints,
+        RGMC_CHECK(
+          run.Triangles == reference.Triangles && run.UniquePoints == reference.UniquePoints,
           "headroom " << headroom << ": " << run.Triangles << " triangles, " << run.UniquePoints
                       << " unique points instead of " << reference.Triangles << ", "
                       << reference.UniquePoints);
@@ -238,10 +243,10 @@ int main(int argc, char* argv[])
       else
       {
         RGMC_CHECK(run.Cells == 0 || run.FailedStage == 3,
-          "headroom " << headroom << ": stage " << run.FailedStage
-                      << " failed but its output has " << run.Cells << " cells");
-        RGMC_CHECK(rgmc_test::SameOnAllRanks(controller,
-                     run.Errors.substr(run.Errors.find("): ") + 1)),
+          "headroom " << headroom << ": stage " << run.FailedStage << " failed but its output has "
+                      << run.Cells << " cells");
+        RGMC_CHECK(
+          rgmc_test::SameOnAllRanks(controller, run.Errors.substr(run.Errors.find("): ") + 1)),
           "headroom " << headroom << ": the ranks' messages differ");
         RGMC_CHECK(!run.File, "headroom " << headroom << ": a failed run left its file");
       }

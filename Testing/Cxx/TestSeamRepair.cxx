@@ -81,8 +81,7 @@ std::vector<Surface> Surfaces()
     },
     0.0, vtkRGMarchingCubes::SEEDED, { { 46.0, 32.0, 32.0 } }, 0 });
   // The phantom's skull: a shell with 5 holes (Euler characteristic 4 - 2 * 5).
-  surfaces.push_back(Surface{ "skull",
-    [](const int extent[6]) { return PhantomPiece(extent, 65); },
+  surfaces.push_back(Surface{ "skull", [](const int extent[6]) { return PhantomPiece(extent, 65); },
     400.0, vtkRGMarchingCubes::SEEDED, { { 0, 0, 105 } }, -6 });
   return surfaces;
 }
@@ -292,7 +291,8 @@ void CompareWithVTK(vtkMultiProcessController* single, vtkPolyData* extracted, d
     {
       double a[3], b[3], before[3];
       ours->GetPoint(p, a);
-      const vtkIdType g = vtkIdTypeArray::SafeDownCast(ours->GetPointData()->GetGlobalIds())->GetValue(p);
+      const vtkIdType g =
+        vtkIdTypeArray::SafeDownCast(ours->GetPointData()->GetGlobalIds())->GetValue(p);
       vtk->GetOutput()->GetPoint(g, b);
       mesh->GetPoint(g, before);
       worst = std::max(worst, std::sqrt(vtkMath::Distance2BetweenPoints(a, b)));
