@@ -26,7 +26,8 @@
 // point) between the seeded surface on r ranks and on 1 rank, and between the seam-repaired,
 // Laplacian-smoothed surface on r ranks and VTK's smoothing (vtkSmoothPolyDataFilter) of the
 // 1-rank surface; also the windowed-sinc smoothing against vtkWindowedSincPolyDataFilter's.
-#include "rgmcTestData.h" // ghost marking
+#include "rgmcBenchmark.h"       // Now, StatusMiB
+#include "rgmcDistributedData.h" // BlockPiece, ghost marking
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGPhantomSource.h"
 #include "vtkRGSeamRepair.h"
@@ -34,13 +35,12 @@
 #include "vtkAppendPolyData.h"
 #include "vtkCellData.h"
 #include "vtkDataSetAttributes.h"
-#include "vtkExtentTranslator.h"
 #include "vtkExtractVOI.h"
 #include "vtkFloatArray.h"
 #include "vtkFlyingEdges3D.h"
 #include "vtkHausdorffDistancePointSetFilter.h"
-#include "vtkLogger.h"
 #include "vtkImageData.h"
+#include "vtkLogger.h"
 #include "vtkMPICommunicator.h"
 #include "vtkMPIController.h"
 #include "vtkMarchingCubes.h"
@@ -51,16 +51,15 @@
 #include "vtkPVContourFilter.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
+#include "vtkRGCompatibility.h"
 #include "vtkSmartPointer.h"
 #include "vtkSmoothPolyDataFilter.h"
-#include "vtkRGCompatibility.h"
 #include "vtkWindowedSincPolyDataFilter.h"
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -75,26 +74,10 @@
 namespace
 {
 
+using rgmc_benchmark::Now;
+using rgmc_benchmark::StatusMiB;
+
 const int DoneTag = 7901;
-
-double Now()
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// A line of /proc/self/status in MiB (VmHWM: the peak resident set; VmRSS: the current one).
-double StatusMiB(const char* field)
-{
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);)
-  {
-    if (line.rfind(field, 0) == 0)
-    {
-      return std::atof(line.c_str() + std::strlen(field) + 1) / 1024.0;
-    }
-  }
-  return 0.0;
-}
 
 /// Restarts the peak resident set from the current one (Linux: "5" into clear_refs).
 bool ResetPeakMemory()
@@ -206,8 +189,8 @@ vtkSmartPointer<vtkImageData> BlobsImage(const std::vector<Blob>& blobs, const i
       {
         for (int i = lo[0]; i <= hi[0]; ++i)
         {
-          const double d2 = (i - b.C[0]) * (i - b.C[0]) + (j - b.C[1]) * (j - b.C[1]) +
-            (k - b.C[2]) * (k - b.C[2]);
+          const double d2 =
+            (i - b.C[0]) * (i - b.C[0]) + (j - b.C[1]) * (j - b.C[1]) + (k - b.C[2]) * (k - b.C[2]);
           v[(k - extent[4]) * nx * ny + (j - extent[2]) * nx + (i - extent[0])] +=
             static_cast<float>(b.Height * std::exp(-d2 * s));
         }
@@ -224,11 +207,7 @@ vtkSmartPointer<vtkImageData> GhostedPiece(const Case& c, int rank, int ranks, v
 {
   const int whole[6] = { 0, c.Dims[0] - 1, 0, c.Dims[1] - 1, 0, c.Dims[2] - 1 };
   int owned[6], ghosted[6];
-  vtkNew<vtkExtentTranslator> split;
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 0, const_cast<int*>(whole), owned, vtkExtentTranslator::BLOCK_MODE, 0);
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 1, const_cast<int*>(whole), ghosted, vtkExtentTranslator::BLOCK_MODE, 0);
+  rgmc_test::BlockPiece(whole, rank, ranks, owned, ghosted);
   vtkSmartPointer<vtkImageData> image;
   if (c.Field == "phantom")
   {
@@ -269,10 +248,8 @@ vtkSmartPointer<vtkImageData> PlainPiece(vtkImageData* ghosted, const Case& c, i
     return ghosted;
   }
   const int whole[6] = { 0, c.Dims[0] - 1, 0, c.Dims[1] - 1, 0, c.Dims[2] - 1 };
-  int owned[6];
-  vtkNew<vtkExtentTranslator> split;
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 0, const_cast<int*>(whole), owned, vtkExtentTranslator::BLOCK_MODE, 0);
+  int owned[6], ghostedExtent[6];
+  rgmc_test::BlockPiece(whole, rank, ranks, owned, ghostedExtent);
   vtkNew<vtkExtractVOI> crop;
   crop->SetInputData(ghosted);
   crop->SetVOI(owned);
@@ -363,7 +340,8 @@ vtkIdType Cells(vtkAlgorithm* filter)
 }
 
 /// The pieces of `piece` gathered on rank 0 of `controller`, appended (rank 0 only).
-vtkSmartPointer<vtkPolyData> GatherSurface(vtkMultiProcessController* controller, vtkPolyData* piece)
+vtkSmartPointer<vtkPolyData> GatherSurface(
+  vtkMultiProcessController* controller, vtkPolyData* piece)
 {
   std::vector<vtkSmartPointer<vtkDataObject>> pieces;
   vtkNew<vtkPolyData> mine;
@@ -472,7 +450,8 @@ void RunCase(const Case& c, vtkMultiProcessController* controller, int cores, vt
     double total = 0;
     for (int r = 0; r < c.Repeats || (total < 0.5 && r < 100); ++r)
     {
-      vtkSmartPointer<vtkAlgorithm> filter = MakeMethod(method, c, ghosted, plain, seeded, controller);
+      vtkSmartPointer<vtkAlgorithm> filter =
+        MakeMethod(method, c, ghosted, plain, seeded, controller);
       controller->Barrier();
       const double t0 = Now();
       filter->Update();
@@ -490,11 +469,11 @@ void RunCase(const Case& c, vtkMultiProcessController* controller, int cores, vt
     if (rank == 0)
     {
       PrintRow({ { "case", Quote(c.Name) }, { "field", Quote(c.Field) },
-        { "dims", "[" + std::to_string(c.Dims[0]) + ", " + std::to_string(c.Dims[1]) + ", " +
+        { "dims",
+          "[" + std::to_string(c.Dims[0]) + ", " + std::to_string(c.Dims[1]) + ", " +
             std::to_string(c.Dims[2]) + "]" },
-        { "ranks", std::to_string(ranks) },
-        { "oversubscribed", ranks > cores ? "true" : "false" }, { "method", Quote(method) },
-        { "triangles", std::to_string(triangles) },
+        { "ranks", std::to_string(ranks) }, { "oversubscribed", ranks > cores ? "true" : "false" },
+        { "method", Quote(method) }, { "triangles", std::to_string(triangles) },
         { "busiest_rank_triangles", std::to_string(busiest) },
         { "min_seconds", Number(times.front()) },
         { "median_seconds", Number(times[times.size() / 2]) },
@@ -511,7 +490,8 @@ void RunCase(const Case& c, vtkMultiProcessController* controller, int cores, vt
   }
   // PASS: the distances, on rank 0 (not timed).
   vtkSmartPointer<vtkPolyData> surface = GatherSurface(controller, seeded);
-  auto smoothed = [&](int method) {
+  auto smoothed = [&](int method)
+  {
     vtkNew<vtkRGSeamRepair> repair;
     repair->SetController(controller);
     repair->SetInputData(seeded);
@@ -786,9 +766,8 @@ int main(int argc, char* argv[])
     Serial serial;
     for (int ranks : c.Ranks)
     {
-      OnFirstRanks(world, ranks, [&](vtkMultiProcessController* group) {
-        RunCase(c, group, cores, mri, serial);
-      });
+      OnFirstRanks(world, ranks,
+        [&](vtkMultiProcessController* group) { RunCase(c, group, cores, mri, serial); });
     }
   }
   world->Finalize();

@@ -13,13 +13,13 @@
 // checks are told apart from its smoothing by its progress (it reports 0.4 when the smoothing
 // starts). Peak memory is each rank's resident-set high-water mark (VmHWM), read after each
 // stage; the stage's figure is the largest over ranks. Prints one JSON object per line on rank 0.
-#include "rgmcTestData.h" // MakeImage, MarkGhostCells
+#include "rgmcBenchmark.h"       // Now, StatusMiB
+#include "rgmcDistributedData.h" // GyroidPiece
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGMergedSurfaceWriter.h"
 #include "vtkRGSeamRepair.h"
 
 #include "vtkCallbackCommand.h"
-#include "vtkExtentTranslator.h"
 #include "vtkImageData.h"
 #include "vtkMPIController.h"
 #include "vtkNew.h"
@@ -27,11 +27,8 @@
 
 #include <unistd.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -39,24 +36,8 @@
 namespace
 {
 
-double Now()
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// A line of /proc/self/status in MiB (VmHWM: the peak resident set).
-double StatusMiB(const char* field)
-{
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);)
-  {
-    if (line.rfind(field, 0) == 0)
-    {
-      return std::atof(line.c_str() + std::strlen(field) + 1) / 1024.0;
-    }
-  }
-  return 0.0;
-}
+using rgmc_benchmark::Now;
+using rgmc_benchmark::StatusMiB;
 
 struct Options
 {
@@ -145,25 +126,8 @@ int main(int argc, char* argv[])
   }
 
   // This rank's piece of the gyroid, with one ghost layer.
-  const int whole[6] = { 0, opt.Size - 1, 0, opt.Size - 1, 0, opt.Size - 1 };
-  int owned[6], ghosted[6];
-  vtkNew<vtkExtentTranslator> split;
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 0, const_cast<int*>(whole), owned, vtkExtentTranslator::BLOCK_MODE, 0);
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 1, const_cast<int*>(whole), ghosted, vtkExtentTranslator::BLOCK_MODE, 0);
-  const double w = 2.0 * M_PI / opt.Period;
   double t0 = Now();
-  vtkSmartPointer<vtkImageData> volume = rgmc_test::MakeImage(ghosted, VTK_FLOAT,
-    [w](int i, int j, int k)
-    {
-      const double x = w * (i + 0.25), y = w * (j + 0.5), z = w * (k + 0.125);
-      return std::sin(x) * std::cos(y) + std::sin(y) * std::cos(z) + std::sin(z) * std::cos(x);
-    });
-  if (ranks > 1)
-  {
-    rgmc_test::MarkGhostCells(volume, owned);
-  }
+  vtkSmartPointer<vtkImageData> volume = rgmc_test::GyroidPiece(opt.Size, opt.Period, rank, ranks);
   volume->SetSpacing(0.1, 0.1, 0.1);
   Report(controller, "make volume", Now() - t0, 0);
 

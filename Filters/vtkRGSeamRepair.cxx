@@ -989,59 +989,42 @@ private:
       [&gid](vtkIdType v, vtkIdType key) { return gid[v] < key; });
   }
 
-  /// Fills the remote slots of `state` with the neighbours' states from their holders.
-  void Fetch(T* state)
+  /// Sends each rank r the triples of `state` at the vertices send[r], and stores the triples
+  /// rank r sends at the vertices receive[r] (both sides list a pair's vertices in one order).
+  template <typename S>
+  void Share(const std::vector<std::vector<vtkIdType>>& send,
+    const std::vector<std::vector<vtkIdType>>& receive, S* state, int tag)
   {
     std::vector<std::vector<double>> out(this->R.Size);
-    for (int s = 0; s < this->R.Size; ++s)
+    for (int r = 0; r < this->R.Size; ++r)
     {
-      for (vtkIdType v : this->Provide[s])
+      for (vtkIdType v : send[r])
       {
-        out[s].insert(out[s].end(), state + 3 * v, state + 3 * v + 3);
+        out[r].insert(out[r].end(), state + 3 * v, state + 3 * v + 3);
       }
     }
-    const auto in = this->R.Exchange(out, this->Partners, StateTag);
-    for (int s = 0; s < this->R.Size; ++s)
+    const auto in = this->R.Exchange(out, this->Partners, tag);
+    for (int r = 0; r < this->R.Size; ++r)
     {
-      const std::vector<vtkIdType>& slots = this->RemoteOrder[s];
-      for (std::size_t i = 0; i < slots.size() && 3 * i + 2 < in[s].size(); ++i)
+      const std::vector<vtkIdType>& list = receive[r];
+      for (std::size_t i = 0; i < list.size() && 3 * i + 2 < in[r].size(); ++i)
       {
         for (int k = 0; k < 3; ++k)
         {
-          state[3 * slots[i] + k] = static_cast<T>(in[s][3 * i + k]);
+          state[3 * list[i] + k] = static_cast<S>(in[r][3 * i + k]);
         }
       }
     }
   }
 
+  /// Fills the remote slots of `state` with the neighbours' states from their holders.
+  void Fetch(T* state) { this->Share(this->Provide, this->RemoteOrder, state, StateTag); }
+
   /// Sends the owned shared vertices' `state` to their other holders.
   template <typename S>
   void Update(S* state, int tag = UpdateTag)
   {
-    std::vector<std::vector<double>> out(this->R.Size);
-    for (int s = 0; s < this->R.Size; ++s)
-    {
-      for (vtkIdType v : this->ToSharer[s])
-      {
-        out[s].insert(out[s].end(), state + 3 * v, state + 3 * v + 3);
-      }
-    }
-    const auto in = this->R.Exchange(out, this->Partners, tag);
-    for (int o = 0; o < this->R.Size; ++o)
-    {
-      if (o == this->R.Rank)
-      {
-        continue;
-      }
-      const std::vector<vtkIdType>& list = this->FromOwner[o];
-      for (std::size_t i = 0; i < list.size() && 3 * i + 2 < in[o].size(); ++i)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          state[3 * list[i] + k] = static_cast<S>(in[o][3 * i + k]);
-        }
-      }
-    }
+    this->Share(this->ToSharer, this->FromOwner, state, tag);
   }
 
   Ranks& R;

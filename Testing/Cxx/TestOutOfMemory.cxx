@@ -9,11 +9,10 @@
 // complete run once the limit is high enough). Not built with the sanitizers: AddressSanitizer
 // reserves terabytes of address space, so an address-space limit cannot work there.
 #include "rgmcCheck.h"
-#include "rgmcDistributedData.h" // SameOnAllRanks
+#include "rgmcDistributedData.h" // GyroidPiece, SameOnAllRanks
 #include "rgmcTestController.h"
 #include "rgmcTestData.h" // MakeImage, MarkGhostCells, MessageCatcher
 
-#include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"
 #include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
@@ -28,26 +27,16 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <iostream>
 #include <string>
 
 namespace
 {
 
-/// A line of /proc/self/status in bytes (VmSize: the address space in use; VmPeak: its peak).
+/// A "Vm..." line of /proc/self/status in bytes.
 long long StatusBytes(const char* field)
 {
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);)
-  {
-    if (line.rfind(field, 0) == 0)
-    {
-      return std::atoll(line.c_str() + std::strlen(field) + 1) * 1024;
-    }
-  }
-  return 0;
+  return rgmc_test::ProcessStatusKiB(field) * 1024;
 }
 
 /// What one run of the job gave on this rank.
@@ -173,25 +162,7 @@ int main(int argc, char* argv[])
   const std::string file = "TestOutOfMemory-" + std::to_string(ranks) + ".ply";
 
   // This rank's piece of a gyroid (one surface through the whole volume, on every seam).
-  const int size = 96;
-  const int whole[6] = { 0, size - 1, 0, size - 1, 0, size - 1 };
-  int owned[6], ghosted[6];
-  vtkNew<vtkExtentTranslator> split;
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 0, const_cast<int*>(whole), owned, vtkExtentTranslator::BLOCK_MODE, 0);
-  split->PieceToExtentThreadSafe(
-    rank, ranks, 1, const_cast<int*>(whole), ghosted, vtkExtentTranslator::BLOCK_MODE, 0);
-  const double w = 2.0 * M_PI / 12.0;
-  vtkSmartPointer<vtkImageData> volume = rgmc_test::MakeImage(ghosted, VTK_FLOAT,
-    [w](int i, int j, int k)
-    {
-      const double x = w * (i + 0.25), y = w * (j + 0.5), z = w * (k + 0.125);
-      return std::sin(x) * std::cos(y) + std::sin(y) * std::cos(z) + std::sin(z) * std::cos(x);
-    });
-  if (ranks > 1)
-  {
-    rgmc_test::MarkGhostCells(volume, owned);
-  }
+  vtkSmartPointer<vtkImageData> volume = rgmc_test::GyroidPiece(96, 12.0, rank, ranks);
 
   // The unlimited run: the expected result, and how much address space each stage needs.
   const long long base = StatusBytes("VmSize:");

@@ -37,15 +37,48 @@ inline std::vector<std::string> Decompositions(int ranks)
   return { "block", "slab-x", "slab-y", "slab-z", "rank0", "empty-rank", "overlap", "mismarked" };
 }
 
+/// This rank's block of `whole` as ParaView splits images: its owned point extent, and the same
+/// with the one ghost layer the pipeline gives vtkRGMarchingCubes.
+inline void BlockPiece(const int whole[6], int rank, int ranks, int owned[6], int ghosted[6])
+{
+  vtkNew<vtkExtentTranslator> split;
+  split->PieceToExtentThreadSafe(
+    rank, ranks, 0, const_cast<int*>(whole), owned, vtkExtentTranslator::BLOCK_MODE, 0);
+  split->PieceToExtentThreadSafe(
+    rank, ranks, 1, const_cast<int*>(whole), ghosted, vtkExtentTranslator::BLOCK_MODE, 0);
+}
+
+/// This rank's block (with its ghost layer, ghost cells marked) of a `size`^3 float gyroid,
+/// sin x cos y + sin y cos z + sin z cos x = 0 with `period` samples per cell: one connected
+/// surface through the whole volume that crosses every partition plane many times.
+inline vtkSmartPointer<vtkImageData> GyroidPiece(int size, double period, int rank, int ranks)
+{
+  const int whole[6] = { 0, size - 1, 0, size - 1, 0, size - 1 };
+  int owned[6], ghosted[6];
+  BlockPiece(whole, rank, ranks, owned, ghosted);
+  const double w = 2.0 * M_PI / period;
+  vtkSmartPointer<vtkImageData> piece = MakeImage(ghosted, VTK_FLOAT,
+    [w](int i, int j, int k)
+    {
+      const double x = w * (i + 0.25), y = w * (j + 0.5), z = w * (k + 0.125);
+      return std::sin(x) * std::cos(y) + std::sin(y) * std::cos(z) + std::sin(z) * std::cos(x);
+    });
+  if (ranks > 1)
+  {
+    MarkGhostCells(piece, owned);
+  }
+  return piece;
+}
+
 /// This rank's piece of `whole` (a point extent with the same number of cells on each axis).
 inline Piece PieceOf(const std::string& how, const int whole[6], int rank, int ranks)
 {
   const int cells = whole[1] - whole[0];
   Piece p;
-  auto block = [&](int piece, int pieces) {
-    vtkNew<vtkExtentTranslator> split;
-    split->PieceToExtentThreadSafe(
-      piece, pieces, 0, const_cast<int*>(whole), p.Owned, vtkExtentTranslator::BLOCK_MODE, 0);
+  auto block = [&](int piece, int pieces)
+  {
+    int ghosted[6];
+    BlockPiece(whole, piece, pieces, p.Owned, ghosted);
   };
   if (how == "block")
   {

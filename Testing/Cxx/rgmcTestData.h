@@ -33,6 +33,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <set>
@@ -322,6 +325,21 @@ inline void WithGhostLayers(const int owned[6], const int whole[6], int levels, 
     out[2 * a] = std::max(whole[2 * a], owned[2 * a] - levels);
     out[2 * a + 1] = std::min(whole[2 * a + 1], owned[2 * a + 1] + levels);
   }
+}
+
+/// A "Vm..." line of /proc/self/status in KiB (VmSize: the address space in use, VmPeak its
+/// peak; VmRSS: the resident set, VmHWM its peak), or 0.
+inline long long ProcessStatusKiB(const char* field)
+{
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+  {
+    if (line.rfind(field, 0) == 0)
+    {
+      return std::atoll(line.c_str() + std::strlen(field) + 1);
+    }
+  }
+  return 0;
 }
 
 /// Collects the error and warning messages a VTK object emits.
