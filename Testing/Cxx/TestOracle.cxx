@@ -18,9 +18,9 @@
 //   and against vtkMarchingCubes with a tolerance of float precision at the coordinates' size.
 #include "rgmcTestData.h"
 
-#include "vtkIdTypeArray.h"
 #include "vtkCellData.h"
 #include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
 #include "vtkIntArray.h"
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGPhantomSource.h"
@@ -59,8 +59,28 @@ void Expect(const std::string& what, const Comparison& c, double normalTolerance
 {
   std::cout << what << ": " << c << "\n";
   RGMC_CHECK(c.SameTriangles(), what << ": " << c);
-  RGMC_CHECK(c.MaxNormalError <= normalTolerance, what << ": normals differ by " << c.MaxNormalError);
+  RGMC_CHECK(
+    c.MaxNormalError <= normalTolerance, what << ": normals differ by " << c.MaxNormalError);
   TotalMerged += static_cast<int>(c.Merged);
+}
+
+/// The comparison itself counts triangles with multiplicity: a mesh with one triangle twice is
+/// not the mesh with it once, either way round.
+void ComparisonCountsMultiplicity(vtkImageData* image, double isovalue)
+{
+  vtkSmartPointer<vtkPolyData> mc = MarchingCubes(image, isovalue);
+  auto twice = vtkSmartPointer<vtkPolyData>::New();
+  twice->DeepCopy(mc);
+  vtkIdType npts;
+  const vtkIdType* pts;
+  twice->GetPolys()->GetCellAtId(0, npts, pts);
+  const std::vector<vtkIdType> first(pts, pts + npts);
+  twice->GetPolys()->InsertNextCell(npts, first.data());
+  const Comparison extra = Compare(twice, mc, 1e-6), missing = Compare(mc, twice, 1e-6);
+  RGMC_CHECK(extra.ExtraOurs == 1 && extra.MissingTheirs == 0 && !extra.SameTriangles(),
+    "a duplicated triangle of ours: " << extra);
+  RGMC_CHECK(missing.MissingTheirs == 1 && missing.ExtraOurs == 0 && !missing.SameTriangles(),
+    "a duplicated triangle of theirs: " << missing);
 }
 
 /// Seeded mode (each seed alone, then all together), All and Largest, against the oracle.
@@ -205,6 +225,7 @@ void Blobs()
 {
   const int extent[6] = { 3, 42, -5, 38, 10, 45 }; // not starting at 0: global indices matter
   auto image = MakeImage(extent, VTK_FLOAT, rgmc_test::Blobs(extent, 40, 7));
+  ComparisonCountsMultiplicity(image, 0.3);
   CheckField("blobs (float32)", image, 0.3, RandomSeeds(image, 6, 11));
 }
 
@@ -250,7 +271,8 @@ void EqualSamples()
   RGMC_CHECK(onGridPoints > 0, "some vertices must sit on grid points");
   std::cout << "equal samples: " << equal << " samples equal the isovalue, " << onGridPoints
             << " vertices on grid points\n";
-  CheckField("quantized (uint8, samples equal to the isovalue)", image, isovalue, RandomSeeds(image, 5, 9));
+  CheckField(
+    "quantized (uint8, samples equal to the isovalue)", image, isovalue, RandomSeeds(image, 5, 9));
 }
 
 /// Random samples in {0, 1, 2} with isovalue 1: a fifth of the samples equal the isovalue, so
@@ -263,10 +285,12 @@ void Degenerate()
   vtkNew<vtkMinimalStandardRandomSequence> random;
   random->SetSeed(1234);
   // Sparse enough to leave many small components that touch in degenerate ways.
-  auto image = MakeImage(extent, VTK_UNSIGNED_CHAR, [&](int, int, int) {
-    const double r = random->GetNextRangeValue(0.0, 1.0);
-    return r < 0.62 ? 0.0 : (r < 0.84 ? 1.0 : 2.0);
-  });
+  auto image = MakeImage(extent, VTK_UNSIGNED_CHAR,
+    [&](int, int, int)
+    {
+      const double r = random->GetNextRangeValue(0.0, 1.0);
+      return r < 0.62 ? 0.0 : (r < 0.84 ? 1.0 : 2.0);
+    });
   CheckField("random {0,1,2} (uint8, a fifth equal to the isovalue)", image, 1.0,
     RandomSeeds(image, 40, 77));
 }

@@ -8,11 +8,10 @@
 #include "vtkAppendPolyData.h"
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
-#include "vtkDataSetAttributes.h"
-#include "vtkUnsignedCharArray.h"
 #include "vtkCleanPolyData.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
 #include "vtkFloatArray.h"
 #include "vtkIdList.h"
@@ -29,6 +28,7 @@
 #include "vtkPolyDataConnectivityFilter.h"
 #include "vtkSmartPointer.h"
 #include "vtkStaticPointLocator.h"
+#include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
 #include <array>
@@ -46,8 +46,8 @@ namespace rgmc_test
 {
 
 /// An image of the given extent whose point array "f" (of VTK type `type`) holds f(i, j, k).
-inline vtkSmartPointer<vtkImageData> MakeImage(const int extent[6], int type,
-  const std::function<double(int, int, int)>& f)
+inline vtkSmartPointer<vtkImageData> MakeImage(
+  const int extent[6], int type, const std::function<double(int, int, int)>& f)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetExtent(const_cast<int*>(extent));
@@ -90,7 +90,8 @@ inline std::function<double(int, int, int)> Blobs(const int extent[6], int count
     b.Width = random->GetNextRangeValue(1.5, 5.0);
     b.Height = random->GetNextRangeValue(-0.6, 1.2);
   }
-  return [bumps](int i, int j, int k) {
+  return [bumps](int i, int j, int k)
+  {
     double v = 0.0;
     for (const Bump& b : bumps)
     {
@@ -140,12 +141,14 @@ inline vtkSmartPointer<vtkPolyData> MarchingCubes(vtkImageData* image, double is
 }
 
 /// The oracle of the seeded mode: for each seed, the connected region of marching cubes that
-/// holds the point closest to it; their union (a region chosen twice appears twice; Compare
-/// identifies vertices by coordinates, so that does not matter).
+/// holds the point closest to it; their union, each region once (two seeds on one region select
+/// it once, as the filter does; regions share no point, so a region whose first point is already
+/// in the union is one chosen before).
 inline vtkSmartPointer<vtkPolyData> ClosestRegions(
   vtkPolyData* mc, const std::vector<std::array<double, 3>>& seeds)
 {
   vtkNew<vtkAppendPolyData> append;
+  std::set<std::array<double, 3>> chosen;
   for (const auto& s : seeds)
   {
     vtkNew<vtkPolyDataConnectivityFilter> conn;
@@ -155,6 +158,21 @@ inline vtkSmartPointer<vtkPolyData> ClosestRegions(
     conn->Update();
     auto region = vtkSmartPointer<vtkPolyData>::New();
     region->ShallowCopy(conn->GetOutput());
+    std::array<double, 3> first;
+    if (region->GetNumberOfPoints() > 0)
+    {
+      region->GetPoint(0, first.data());
+      if (chosen.count(first))
+      {
+        continue;
+      }
+    }
+    for (vtkIdType p = 0; p < region->GetNumberOfPoints(); ++p)
+    {
+      std::array<double, 3> x;
+      region->GetPoint(p, x.data());
+      chosen.insert(x);
+    }
     append->AddInputData(region);
   }
   append->Update();
@@ -166,10 +184,10 @@ struct Comparison
 {
   vtkIdType OursTriangles = 0;
   vtkIdType TheirTriangles = 0;
-  vtkIdType Unmatched = 0;      // our vertices with no counterpart within the tolerance
-  vtkIdType Merged = 0;         // our vertices that share a counterpart with another (float merge)
-  vtkIdType MissingTheirs = 0;  // their triangles we lack
-  vtkIdType ExtraOurs = 0;      // our triangles they lack
+  vtkIdType Unmatched = 0;     // our vertices with no counterpart within the tolerance
+  vtkIdType Merged = 0;        // our vertices that share a counterpart with another (float merge)
+  vtkIdType MissingTheirs = 0; // their triangles we lack
+  vtkIdType ExtraOurs = 0;     // our triangles they lack
   double MaxDistance = 0;
   double MaxNormalError = 0;
 
@@ -180,8 +198,8 @@ struct Comparison
 };
 
 /// Matches each of our points to the nearest of theirs (within `tolerance`) and compares the
-/// triangles as sets of matched vertex triples, and the normals of matched vertices. Their
-/// vertices are identified by exact coordinates.
+/// triangles as multisets of matched vertex triples (a triangle emitted twice is one too many),
+/// and the normals of matched vertices. Their vertices are identified by exact coordinates.
 inline Comparison Compare(vtkPolyData* ours, vtkPolyData* theirs, double tolerance)
 {
   Comparison c;
@@ -254,8 +272,9 @@ inline Comparison Compare(vtkPolyData* ours, vtkPolyData* theirs, double toleran
     }
   }
 
-  auto triangles = [](vtkPolyData* pd, const std::vector<vtkIdType>& map) {
-    std::set<std::array<vtkIdType, 3>> set;
+  auto triangles = [](vtkPolyData* pd, const std::vector<vtkIdType>& map)
+  {
+    std::map<std::array<vtkIdType, 3>, vtkIdType> counts;
     vtkIdType npts;
     const vtkIdType* pts;
     vtkCellArray* cells = pd->GetPolys();
@@ -265,30 +284,35 @@ inline Comparison Compare(vtkPolyData* ours, vtkPolyData* theirs, double toleran
       std::sort(t.begin(), t.end());
       if (t[0] != t[1] && t[1] != t[2]) // a triangle that a float merge collapses is dropped
       {
-        set.insert(t);
+        ++counts[t];
       }
     }
-    return set;
+    return counts;
   };
   const auto a = triangles(ours, match);
   const auto b = triangles(theirs, canon);
-  for (const auto& t : a)
+  auto excess = [](const std::map<std::array<vtkIdType, 3>, vtkIdType>& x,
+                  const std::map<std::array<vtkIdType, 3>, vtkIdType>& y)
   {
-    c.ExtraOurs += b.count(t) == 0;
-  }
-  for (const auto& t : b)
-  {
-    c.MissingTheirs += a.count(t) == 0;
-  }
+    vtkIdType n = 0;
+    for (const auto& t : x)
+    {
+      auto other = y.find(t.first);
+      n += std::max<vtkIdType>(0, t.second - (other == y.end() ? 0 : other->second));
+    }
+    return n;
+  };
+  c.ExtraOurs = excess(a, b);
+  c.MissingTheirs = excess(b, a);
   return c;
 }
 
 inline std::ostream& operator<<(std::ostream& os, const Comparison& c)
 {
   return os << "ours " << c.OursTriangles << " triangles, theirs " << c.TheirTriangles
-            << ", unmatched vertices " << c.Unmatched << ", float-merged " << c.Merged
-            << ", extra " << c.ExtraOurs << ", missing " << c.MissingTheirs << ", max distance "
-            << c.MaxDistance << ", max normal error " << c.MaxNormalError;
+            << ", unmatched vertices " << c.Unmatched << ", float-merged " << c.Merged << ", extra "
+            << c.ExtraOurs << ", missing " << c.MissingTheirs << ", max distance " << c.MaxDistance
+            << ", max normal error " << c.MaxNormalError;
 }
 
 /// Marks the cells of `image` outside the cells of `owned` (a point extent) as ghost cells
