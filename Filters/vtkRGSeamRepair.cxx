@@ -520,21 +520,7 @@ public:
     if (!this->R.Step("list the edges at the seams", problem,
           [&]()
           {
-            cornerOffsets.assign(static_cast<std::size_t>(this->N) + 1, 0);
-            for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
-            {
-              ++cornerOffsets[static_cast<vtkIdType>(this->Triangles[c]) + 1];
-            }
-            for (vtkIdType v = 0; v < this->N; ++v)
-            {
-              cornerOffsets[v + 1] += cornerOffsets[v];
-            }
-            corners.resize(static_cast<std::size_t>(3 * this->NumTriangles));
-            std::vector<vtkIdType> fill(cornerOffsets.begin(), cornerOffsets.end() - 1);
-            for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
-            {
-              corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = c;
-            }
+            this->CornersAround(cornerOffsets, corners);
             for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
             {
               const int owner = this->Num.SharedOwner[i];
@@ -811,12 +797,22 @@ public:
     rgmc::SincWindow window, const std::function<bool(double)>& progress, std::string& problem)
   {
     const std::size_t size = 3 * (this->N + this->RemoteGids.size());
-    std::vector<T> a, b, c, sum;
+    std::vector<T> a, b, c, sum;       // windowed sinc: in the points' type, as VTK's filter
+    std::vector<double> current, next; // Laplacian: in double, rounded once at the end
     std::vector<double> coefficients;
     const bool sinc = method == vtkRGSeamRepair::WINDOWED_SINC;
     if (!this->R.Step("smooth the surface", problem,
           [&]()
           {
+            if (!sinc)
+            {
+              current.resize(size);
+              next.resize(size);
+              std::copy(this->X, this->X + 3 * this->N, current.begin());
+              std::copy(this->RemoteInitial.begin(), this->RemoteInitial.end(),
+                current.begin() + 3 * this->N);
+              return;
+            }
             a.resize(size);
             b.resize(size);
             std::copy(this->X, this->X + 3 * this->N, a.begin());
@@ -827,7 +823,6 @@ public:
                 a[3 * (this->N + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
               }
             }
-            if (sinc)
             {
               c.resize(size);
               sum.resize(size);
@@ -847,12 +842,17 @@ public:
           aborted = true;
           break;
         }
-        this->Fetch(a.data());
-        rgmc::LaplacianStep(this->Stencil, this->Owned, a.data(), b.data(), relaxation);
-        this->Update(b.data());
-        std::swap(a, b);
+        this->Fetch(current.data());
+        rgmc::LaplacianStep(this->Stencil, this->Owned, current.data(), next.data(), relaxation);
+        this->Update(next.data());
+        std::swap(current, next);
       }
-      this->Smoothed.swap(a);
+      std::vector<double>().swap(next);
+      if (!this->R.Step("smooth the surface", problem,
+            [&]() { this->Smoothed.assign(current.begin(), current.begin() + 3 * this->N); }))
+      {
+        return false;
+      }
     }
     else
     {
@@ -881,6 +881,10 @@ public:
       this->Update(sum.data());
       this->Smoothed.swap(sum);
     }
+    // The stencils are done with: the normals need the memory.
+    std::vector<std::int64_t>().swap(this->Stencil.Neighbours);
+    std::vector<std::int64_t>().swap(this->Stencil.Offsets);
+    std::vector<std::int64_t>().swap(this->Owned);
     if (!this->R.Agree(true, problem) || aborted)
     {
       return false;
@@ -889,72 +893,133 @@ public:
     return true;
   }
 
-  /// Area-weighted vertex normals of the smoothed positions, summed at owners. Collective; empty
-  /// on failure (on every rank, with `problem`).
+  /// Area-weighted vertex normals of the smoothed positions. Each vertex sums its triangles'
+  /// area vectors in one order fixed by the mesh (by the triangles' sorted global ids), at its
+  /// owner, so that the normals are the same to the bit for any number of ranks. Collective;
+  /// empty on failure (on every rank, with `problem`).
   std::vector<float> Normals(std::string& problem)
   {
+    const std::vector<vtkIdType>& gid = this->Num.Gid;
+    const T* x = this->Smoothed.data();
+    // A triangle: its sorted global ids, and its area vector taken from its corner of smallest
+    // global id (orientation kept), so that every rank computes the same bits.
+    struct Term
+    {
+      std::array<vtkIdType, 3> Key;
+      double Cross[3];
+      bool operator<(const Term& o) const { return this->Key < o.Key; }
+    };
+    auto term = [&](vtkIdType t)
+    {
+      vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
+        static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
+        static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
+      const int first =
+        gid[c[0]] < gid[c[1]] ? (gid[c[0]] < gid[c[2]] ? 0 : 2) : (gid[c[1]] < gid[c[2]] ? 1 : 2);
+      std::rotate(c, c + first, c + 3);
+      Term out;
+      double e1[3], e2[3];
+      for (int k = 0; k < 3; ++k)
+      {
+        e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
+        e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
+      }
+      vtkMath::Cross(e1, e2, out.Cross);
+      out.Key = { gid[c[0]], gid[c[1]], gid[c[2]] };
+      std::sort(out.Key.begin(), out.Key.end());
+      return out;
+    };
+    std::vector<vtkIdType> cornerOffsets, corners;
+    std::vector<Term> terms;
+    auto localTerms = [&](vtkIdType v)
+    {
+      terms.clear();
+      for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
+      {
+        terms.push_back(term(corners[c] / 3));
+      }
+    };
+    auto sum = [&](double n[3])
+    {
+      std::sort(terms.begin(), terms.end());
+      n[0] = n[1] = n[2] = 0;
+      for (const Term& t : terms)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          n[k] += t.Cross[k];
+        }
+      }
+      vtkMath::Normalize(n);
+    };
+
+    // The terms of shared vertices go to their owners (in gid order, as the owners list them).
     std::vector<double> n;
-    std::vector<std::vector<double>> partial(this->R.Size);
+    std::vector<std::vector<vtkIdType>> outgoing(this->R.Size);
     if (!this->R.Step("compute normals", problem,
           [&]()
           {
             n.assign(3 * this->N, 0.0);
-            const T* x = this->Smoothed.data();
-            for (vtkIdType t = 0; t < this->NumTriangles; ++t)
-            {
-              const vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
-                static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
-                static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
-              double e1[3], e2[3], cross[3];
-              for (int k = 0; k < 3; ++k)
-              {
-                e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
-                e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
-              }
-              vtkMath::Cross(e1, e2, cross);
-              for (int k = 0; k < 3; ++k)
-              {
-                for (int corner = 0; corner < 3; ++corner)
-                {
-                  n[3 * c[corner] + k] += cross[k];
-                }
-              }
-            }
-            // Partial sums of shared vertices to their owners, added in rank order; results back.
+            this->CornersAround(cornerOffsets, corners);
             for (int o = 0; o < this->R.Size; ++o)
             {
               for (vtkIdType v : this->FromOwner[o])
               {
-                partial[o].insert(partial[o].end(), &n[3 * v], &n[3 * v] + 3);
+                localTerms(v);
+                outgoing[o].push_back(static_cast<vtkIdType>(terms.size()));
+                for (const Term& t : terms)
+                {
+                  outgoing[o].insert(outgoing[o].end(),
+                    { t.Key[0], t.Key[1], t.Key[2], PackDouble(t.Cross[0]), PackDouble(t.Cross[1]),
+                      PackDouble(t.Cross[2]) });
+                }
               }
             }
           }))
     {
       return {};
     }
-    const auto sums = this->R.Exchange(partial, this->Partners, NormalTag);
+    const auto incoming = this->R.Exchange(outgoing, this->Partners, NormalTag);
     std::vector<float> normals;
     if (!this->R.Step("compute normals", problem,
           [&]()
           {
+            for (vtkIdType v = 0; v < this->N; ++v)
+            {
+              localTerms(v);
+              sum(&n[3 * v]);
+            }
+            // Owned shared vertices: their own terms and every holder's, in the same order.
+            std::vector<std::size_t> cursor(this->R.Size, 0);
+            std::vector<std::pair<vtkIdType, int>> order; // (gid, sharer) of owned shared vertices
             for (int s = 0; s < this->R.Size; ++s)
             {
-              if (s == this->R.Rank)
+              if (s != this->R.Rank)
               {
-                continue;
-              }
-              const std::vector<vtkIdType>& list = this->ToSharer[s];
-              for (std::size_t i = 0; i < list.size() && 3 * i + 2 < sums[s].size(); ++i)
-              {
-                for (int k = 0; k < 3; ++k)
+                for (vtkIdType v : this->ToSharer[s])
                 {
-                  n[3 * list[i] + k] += sums[s][3 * i + k];
+                  order.emplace_back(gid[v], s);
                 }
               }
             }
-            for (vtkIdType v = 0; v < this->N; ++v)
+            std::sort(order.begin(), order.end());
+            for (std::size_t i = 0; i < order.size();)
             {
-              vtkMath::Normalize(&n[3 * v]);
+              const vtkIdType v = this->VertexOfGid(order[i].first);
+              localTerms(v);
+              for (; i < order.size() && order[i].first == gid[v]; ++i)
+              {
+                const std::vector<vtkIdType>& in = incoming[order[i].second];
+                std::size_t& at = cursor[order[i].second];
+                const vtkIdType count = at < in.size() ? in[at++] : 0;
+                for (vtkIdType j = 0; j < count && at + 5 < in.size(); ++j, at += 6)
+                {
+                  terms.push_back(Term{ { in[at], in[at + 1], in[at + 2] },
+                    { UnpackDouble(in[at + 3]), UnpackDouble(in[at + 4]),
+                      UnpackDouble(in[at + 5]) } });
+                }
+              }
+              sum(&n[3 * v]);
             }
           }))
     {
@@ -971,6 +1036,26 @@ public:
   std::vector<T> Smoothed; // positions of this rank's vertices after smoothing
 
 private:
+  /// The triangle corners (3 t + k) at each vertex, in compressed rows.
+  void CornersAround(std::vector<vtkIdType>& offsets, std::vector<vtkIdType>& corners) const
+  {
+    offsets.assign(static_cast<std::size_t>(this->N) + 1, 0);
+    for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
+    {
+      ++offsets[static_cast<vtkIdType>(this->Triangles[c]) + 1];
+    }
+    for (vtkIdType v = 0; v < this->N; ++v)
+    {
+      offsets[v + 1] += offsets[v];
+    }
+    corners.resize(static_cast<std::size_t>(3 * this->NumTriangles));
+    std::vector<vtkIdType> fill(offsets.begin(), offsets.end() - 1);
+    for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
+    {
+      corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = c;
+    }
+  }
+
   int MaskOf(vtkIdType v) const
   {
     const T* x = this->X + 3 * v;
@@ -1018,7 +1103,11 @@ private:
   }
 
   /// Fills the remote slots of `state` with the neighbours' states from their holders.
-  void Fetch(T* state) { this->Share(this->Provide, this->RemoteOrder, state, StateTag); }
+  template <typename S>
+  void Fetch(S* state)
+  {
+    this->Share(this->Provide, this->RemoteOrder, state, StateTag);
+  }
 
   /// Sends the owned shared vertices' `state` to their other holders.
   template <typename S>

@@ -136,8 +136,8 @@ struct Stencils
 };
 
 /// One Jacobi Laplacian step for the vertices `points[r]` with stencil row r:
-/// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T (the
-/// mesh's point type: each step is stored in it, as VTK's filters do).
+/// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T
+/// (Seam Repair iterates in double and rounds to the points' type once, at the end).
 template <typename T>
 void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* cur,
   T* next, double relaxation)

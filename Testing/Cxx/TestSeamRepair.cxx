@@ -17,6 +17,9 @@
 #include "vtkFieldData.h"
 #include "vtkFlyingEdges3D.h"
 #include "vtkIdTypeArray.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
 #include "vtkRGCompatibility.h"
 #include "vtkRGPhantomSource.h"
 #include "vtkRGSeamRepair.h"
@@ -24,6 +27,7 @@
 
 #include <cstring>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 using namespace rgmc_test;
@@ -312,6 +316,94 @@ void CompareWithVTK(vtkMultiProcessController* single, vtkPolyData* extracted, d
   }
 }
 
+/// Normals after smoothing are summed in an order fixed by the mesh, not by the ranks. A fan of
+/// three triangles around vertex 0 whose area vectors are +1e16, -1e16 and +1 along z: summed in
+/// the 1-rank order (A, B, C) that gives (0, 0, 1); summed per rank with rank 0 holding A and C
+/// and rank 1 holding B, it would give (A + C) + B = 0. The normal must be the same, to the bit,
+/// on any number of ranks. (Relaxation 0: the smoothing moves nothing, the normals are computed.)
+void NormalsInCanonicalOrder(vtkMultiProcessController* controller)
+{
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  const double big = 1e8;
+  const double xyz[7][3] = { { 0, 0, 0 }, { big, 0, 0 }, { 0, big, 0 }, { 0, -big, 0 },
+    { -big, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } };
+  const vtkIdType fan[3][3] = { { 0, 1, 2 }, { 0, 3, 4 }, { 0, 5, 6 } }; // A, B, C
+  auto mesh = [&](const std::vector<int>& triangles)
+  {
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    vtkNew<vtkIdTypeArray> keys;
+    keys->SetName("VertexKey");
+    vtkNew<vtkCellArray> polys;
+    std::map<vtkIdType, vtkIdType> local;
+    for (int t : triangles)
+    {
+      vtkIdType ids[3];
+      for (int k = 0; k < 3; ++k)
+      {
+        const vtkIdType key = fan[t][k];
+        auto found = local.find(key);
+        if (found == local.end())
+        {
+          found = local.emplace(key, points->InsertNextPoint(xyz[key])).first;
+          keys->InsertNextValue(key);
+        }
+        ids[k] = found->second;
+      }
+      polys->InsertNextCell(3, ids);
+    }
+    pd->SetPoints(points);
+    pd->SetPolys(polys);
+    pd->GetPointData()->SetGlobalIds(keys);
+    return pd;
+  };
+  auto normalOfVertex0 = [](vtkPolyData* pd, double n[3])
+  {
+    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+    for (vtkIdType p = 0; ids && p < pd->GetNumberOfPoints(); ++p)
+    {
+      if (ids->GetValue(p) == 0 && pd->GetPointData()->GetNormals())
+      {
+        pd->GetPointData()->GetNormals()->GetTuple(p, n);
+        return true;
+      }
+    }
+    return false;
+  };
+  auto repair = [](vtkMultiProcessController* c, vtkPolyData* input)
+  {
+    vtkNew<vtkRGSeamRepair> r;
+    r->SetController(c);
+    r->SetInputData(input);
+    r->SetSmoothingMethod(vtkRGSeamRepair::LAPLACIAN);
+    r->SetRelaxationFactor(0.0);
+    r->Update();
+    auto out = vtkSmartPointer<vtkPolyData>::New();
+    out->ShallowCopy(r->GetOutput());
+    return out;
+  };
+  vtkNew<vtkDummyController> single;
+  double expected[3] = { 0, 0, 0 }, got[3] = { 0, 0, 0 };
+  const bool found = normalOfVertex0(repair(single, mesh({ 0, 1, 2 })), expected);
+  RGMC_CHECK(found && expected[2] == 1.0, "the fan's normal on 1 rank: " << expected[2]);
+  const std::vector<int> mine = ranks == 1 ? std::vector<int>{ 0, 2, 1 }
+    : rank == 0                            ? std::vector<int>{ 0, 2 }
+    : rank == 1                            ? std::vector<int>{ 1 }
+                                           : std::vector<int>{};
+  vtkSmartPointer<vtkPolyData> out = repair(controller, mesh(mine));
+  double mineNormal[4] = { 0, 0, 0, 0 }, all[4] = { 0, 0, 0, 0 };
+  if (normalOfVertex0(out, got) && rank == 0)
+  {
+    mineNormal[0] = got[0], mineNormal[1] = got[1], mineNormal[2] = got[2], mineNormal[3] = 1;
+  }
+  controller->AllReduce(mineNormal, all, 4, vtkCommunicator::SUM_OP);
+  RGMC_CHECK(all[3] == 1 && all[0] == expected[0] && all[1] == expected[1] && all[2] == expected[2],
+    "the fan's normal on " << ranks << " ranks (triangles in another order): (" << all[0] << ", "
+                           << all[1] << ", " << all[2] << "), on 1 rank (" << expected[0] << ", "
+                           << expected[1] << ", " << expected[2] << ")");
+}
+
 void BadInput(vtkMultiProcessController* controller)
 {
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
@@ -528,6 +620,7 @@ int main(int argc, char* argv[])
       }
     }
   }
+  NormalsInCanonicalOrder(controller);
   BadInput(controller);
   Abort(controller);
 
