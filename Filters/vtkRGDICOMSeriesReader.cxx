@@ -1110,8 +1110,22 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
         }
         // GDCM's parser and codecs, given the pixel description of the header scan (its
         // ImageReader also guesses geometry, and asserts on some valid files while doing so).
+        // Bytes after the last element (padding, junk) are not GDCM's to parse: it gets the
+        // data set alone.
         gdcm::Reader reader;
-        reader.SetFileName(slice.Path.c_str());
+        std::istringstream dataSet;
+        if (structure.TrailingBytes > 0)
+        {
+          std::string bytes(static_cast<std::size_t>(structure.DataSetEnd), '\0');
+          std::ifstream file(slice.Path, std::ios::binary);
+          file.read(&bytes[0], static_cast<std::streamsize>(bytes.size()));
+          dataSet.str(bytes);
+          reader.SetStream(dataSet);
+        }
+        else
+        {
+          reader.SetFileName(slice.Path.c_str());
+        }
         try
         {
           if (reader.Read() && reader.GetFile().GetDataSet().FindDataElement(PixelDataTag))

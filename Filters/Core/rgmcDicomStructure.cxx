@@ -237,9 +237,22 @@ public:
     while (untilDelimiter || at < end)
     {
       Element e;
-      if (!this->Header(at, end, sx, e))
+      // What real files carry after their last element, as pydicom and dcmtk accept it: zero
+      // bytes (a scanner's padding), or anything after the pixel data.
+      // (Not in a deflated data set: GDCM inflates and parses all of it, so its end must hold.)
+      const bool topLevel = depth == 0 && !untilDelimiter && !this->S.InMemory;
+      const bool element = this->Header(at, end, sx, e);
+      if (!element || (topLevel && this->R.HasPixelData && !this->Plausible(e, at, end)))
       {
-        return false;
+        if (!topLevel || !(this->R.HasPixelData || this->ZerosFrom(at, end)))
+        {
+          return false;
+        }
+        this->R.Problem.clear();
+        this->R.TrailingBytes = end - at;
+        this->R.DataSetEnd = at;
+        after = end;
+        return true;
       }
       if (e.Group == 0xfffe)
       {
@@ -304,6 +317,10 @@ public:
           return false;
         }
       }
+      if (depth == 0)
+      {
+        this->LastTopTag = (std::uint32_t(e.Group) << 16) | e.Number;
+      }
       if (depth == 0 && e.Group == 0x0002 && e.Number == 0x0010 && e.Length < 256)
       {
         std::string uid(e.Length, '\0');
@@ -320,6 +337,39 @@ public:
     return true;
   }
 
+  /// Whether the bytes from `at` to `end` are all zero.
+  bool ZerosFrom(std::uint64_t at, std::uint64_t end)
+  {
+    unsigned char block[65536];
+    while (at < end)
+    {
+      const std::size_t n =
+        static_cast<std::size_t>(std::min<std::uint64_t>(sizeof block, end - at));
+      if (!this->S.Read(at, block, n))
+      {
+        return false;
+      }
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        if (block[i] != 0)
+        {
+          return false;
+        }
+      }
+      at += n;
+    }
+    return true;
+  }
+
+  /// Whether a top-level element read where trailing bytes may start is an element: a tag that
+  /// does not go back (elements are in increasing tag order) and a value inside the file.
+  bool Plausible(const Element& e, std::uint64_t at, std::uint64_t end) const
+  {
+    const std::uint32_t tag = (std::uint32_t(e.Group) << 16) | e.Number;
+    return tag > this->LastTopTag && (e.Length == Undefined || e.Value + e.Length <= end) &&
+      at < end;
+  }
+
   static std::string Hex(std::uint16_t v)
   {
     static const char digits[] = "0123456789ABCDEF";
@@ -334,6 +384,7 @@ public:
   Source& S;
   DicomStructure& R;
   bool FirstItem = true;
+  std::uint32_t LastTopTag = 0;
 };
 
 /// Inflates raw deflate data from `at` to the end of the file (the deflated transfer syntax).

@@ -30,6 +30,8 @@ struct DicomStructure
                                        // directly readable, as in a deflated data set)
   bool BigEndian = false;              // the data set's byte order
   bool PixelDataWords = false;         // native pixel data of VR OW (16-bit words) explicitly
+  std::uint64_t TrailingBytes = 0;     // bytes after the last element (zeros, or after pixel data)
+  std::uint64_t DataSetEnd = 0;        // where they start (0: none)
   /// Encapsulated pixel data: (offset, length) of each fragment after the offset table.
   std::vector<std::pair<std::uint64_t, std::uint64_t>> Fragments;
 };

@@ -10,8 +10,11 @@
 #include "vtkDummyController.h"
 #include "vtkRGDICOMSeriesReader.h"
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 
 using namespace rgmc_test;
@@ -47,6 +50,19 @@ std::vector<Entry> Manifest(const std::string& path)
     entries.push_back(e);
   }
   return entries;
+}
+
+/// The file's bytes.
+std::vector<char> Bytes(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void Save(const std::string& path, const std::vector<char>& bytes)
+{
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 std::vector<double> Samples(const std::string& path)
@@ -152,6 +168,102 @@ int main()
       }
     }
   }
+  // What real scanners and archives write after the last element, on real files in three
+  // syntaxes: read, with the samples pydicom decodes from the file without them. And what is
+  // really broken is still refused.
+  struct Quirk
+  {
+    std::string Name;
+    std::vector<char> Tail;
+  };
+  const std::vector<std::pair<std::string, std::string>> files = { { "CT_small.dcm", "explicit" },
+    { "MR_small_implicit.dcm", "implicit" }, { "MR_small_bigendian.dcm", "big" } };
+  for (const auto& file : files)
+  {
+    const std::string name = file.first, syntax = file.second;
+    const std::vector<char> original = Bytes(std::string(RGMC_PYDICOM_DIR) + "/" + name);
+    const std::vector<double> theirs = Samples(oracle + "/" + name + ".f64");
+    // Data Set Trailing Padding (FFFC,FFFC), OB, 6 bytes, in the file's own syntax.
+    std::vector<char> padding;
+    if (syntax == "big")
+    {
+      padding = { '\xff', '\xfc', '\xff', '\xfc', 'O', 'B', 0, 0, 0, 0, 0, 6, 0, 0, 0, 0, 0, 0 };
+    }
+    else if (syntax == "explicit")
+    {
+      padding = { '\xfc', '\xff', '\xfc', '\xff', 'O', 'B', 0, 0, 6, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+    }
+    else
+    {
+      padding = { '\xfc', '\xff', '\xfc', '\xff', 6, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+    }
+    std::vector<char> junk(3001);
+    std::uint32_t state = 20261123;
+    for (char& c : junk)
+    {
+      state = state * 1664525u + 1013904223u;
+      c = static_cast<char>(state >> 24);
+    }
+    const std::vector<Quirk> quirks = { { "2.5 MB of zero bytes after the pixel data",
+                                          std::vector<char>(2500000, 0) },
+      { "Data Set Trailing Padding (FFFC,FFFC)", padding },
+      { "3001 bytes of junk after the pixel data", junk } };
+    for (const Quirk& q : quirks)
+    {
+      std::vector<char> bytes = original;
+      bytes.insert(bytes.end(), q.Tail.begin(), q.Tail.end());
+      const std::string dir = work + "/quirk-" + std::to_string(&q - quirks.data()) + "-" + name;
+      fs::create_directories(dir);
+      Save(dir + "/" + name, bytes);
+      vtkNew<vtkRGDICOMSeriesReader> reader;
+      reader->SetController(controller);
+      reader->SetFileName((dir + "/" + name).c_str());
+      PieceRead r = ReadPiece(reader, 0, 1, 0);
+      vtkIdType differ = -1;
+      if (r.Ok)
+      {
+        vtkDataArray* ours = r.Image->GetPointData()->GetScalars();
+        differ = ours->GetNumberOfValues() == static_cast<vtkIdType>(theirs.size()) ? 0 : -2;
+        for (vtkIdType n = 0; differ >= 0 && n < static_cast<vtkIdType>(theirs.size()); ++n)
+        {
+          const double b =
+            ours->GetDataType() == VTK_FLOAT ? static_cast<float>(theirs[n]) : theirs[n];
+          differ += ours->GetComponent(n, 0) != b;
+        }
+      }
+      RGMC_CHECK(r.Ok && differ == 0,
+        name << " with " << q.Name << ": " << (r.Ok ? "" : ReaderMessage(r.Errors))
+             << (r.Ok ? std::to_string(differ) + " samples differ from pydicom's" : ""));
+      std::cout << "read as pydicom decodes the file without them: " << name << " with " << q.Name
+                << "\n";
+    }
+  }
+  {
+    // Really broken: an element's value representation overwritten before the pixel data.
+    std::vector<char> bytes = Bytes(std::string(RGMC_PYDICOM_DIR) + "/CT_small.dcm");
+    const std::string vr = "DA";
+    auto at = std::search(bytes.begin() + 132, bytes.end(), vr.begin(), vr.end());
+    RGMC_CHECK(at != bytes.end(), "CT_small.dcm has no DA element");
+    if (at != bytes.end())
+    {
+      at[0] = 'Z';
+      at[1] = 'Z';
+      const std::string dir = work + "/broken-vr";
+      fs::create_directories(dir);
+      Save(dir + "/CT_small.dcm", bytes);
+      vtkNew<vtkRGDICOMSeriesReader> reader;
+      reader->SetController(controller);
+      reader->SetFileName((dir + "/CT_small.dcm").c_str());
+      PieceRead r = ReadPiece(reader, 0, 1, 0);
+      const std::string message = ReaderMessage(r.Errors);
+      RGMC_CHECK(!r.Ok &&
+          message.find("is truncated or corrupt: an element has no valid value "
+                       "representation at byte " +
+            std::to_string(at - bytes.begin() - 4)) != std::string::npos,
+        "a broken value representation before the pixel data gave [" << message << "]");
+    }
+  }
+
   std::cout << compared << " files decode exactly as pydicom decodes them, over " << syntaxes.size()
             << " transfer syntaxes:";
   for (const auto& s : syntaxes)
