@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -237,6 +238,40 @@ int main()
       std::cout << "read as pydicom decodes the file without them: " << name << " with " << q.Name
                 << "\n";
     }
+  }
+  {
+    // No preamble, no "DICM", no file meta information: MR_small_implicit.dcm's bare data set
+    // (implicit VR little endian), as older archives hold them.
+    const std::string name = "MR_small_implicit.dcm";
+    const std::vector<char> original = Bytes(std::string(RGMC_PYDICOM_DIR) + "/" + name);
+    // (0002,0000) UL, explicit VR little endian, right after "DICM": the meta group's length.
+    std::uint32_t metaLength = 0;
+    std::memcpy(&metaLength, original.data() + 132 + 8, 4);
+    const std::vector<char> bare(original.begin() + 132 + 12 + metaLength, original.end());
+    const std::string dir = work + "/bare-" + name;
+    fs::create_directories(dir);
+    Save(dir + "/" + name, bare);
+    vtkNew<vtkRGDICOMSeriesReader> reader;
+    reader->SetController(controller);
+    reader->SetFileName((dir + "/" + name).c_str());
+    PieceRead r = ReadPiece(reader, 0, 1, 0);
+    const std::vector<double> theirs = Samples(oracle + "/" + name + ".f64");
+    vtkIdType differ = -1;
+    if (r.Ok &&
+      r.Image->GetPointData()->GetScalars()->GetNumberOfValues() ==
+        static_cast<vtkIdType>(theirs.size()))
+    {
+      differ = 0;
+      for (vtkIdType n = 0; n < static_cast<vtkIdType>(theirs.size()); ++n)
+      {
+        differ += r.Image->GetPointData()->GetScalars()->GetComponent(n, 0) != theirs[n];
+      }
+    }
+    RGMC_CHECK(r.Ok && differ == 0,
+      name << " as a bare data set: "
+           << (r.Ok ? std::to_string(differ) + " samples differ" : ReaderMessage(r.Errors)));
+    std::cout << "read as pydicom decodes the original: " << name
+              << " without preamble and file meta information\n";
   }
   {
     // Really broken: an element's value representation overwritten before the pixel data.
