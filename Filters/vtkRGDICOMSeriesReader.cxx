@@ -829,22 +829,40 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
       }
     }
     sliceSpacing = extentAlong / (files.size() - 1);
-    std::string worst;
+    std::size_t worst = 1;
+    double smallest = extentAlong, largest = 0.0;
     for (std::size_t s = 1; s < files.size(); ++s)
     {
-      const double d = std::fabs(files[s].Projection - files[s - 1].Projection - sliceSpacing);
-      if (d > deviation)
+      const double gap = files[s].Projection - files[s - 1].Projection;
+      smallest = std::min(smallest, gap);
+      largest = std::max(largest, gap);
+      if (std::fabs(gap - sliceSpacing) > deviation)
       {
-        deviation = d;
-        worst = files[s].Path;
+        deviation = std::fabs(gap - sliceSpacing);
+        worst = s;
       }
+    }
+    // Slices are never stacked as if evenly spaced when they are not (a missing slice, a
+    // variable spacing): under 1% of the mean gap, a warning with the spread; beyond, an error
+    // that names the gap.
+    if (deviation >= 0.01 * sliceSpacing)
+    {
+      message = "the slices of " + directory + " are not evenly spaced: " + files[worst - 1].Path +
+        " and " + files[worst].Path + " are " +
+        Describe(files[worst].Projection - files[worst - 1].Projection) +
+        " mm apart along the slice normal (at " + Describe(files[worst - 1].Projection) + " and " +
+        Describe(files[worst].Projection) + " mm), the mean gap is " + Describe(sliceSpacing) +
+        " mm (a missing slice, or a variable spacing); gaps range from " + Describe(smallest) +
+        " to " + Describe(largest) + " mm";
+      return false;
     }
     if (deviation > std::max(1e-3 * sliceSpacing, 1e-4))
     {
       warnings << "irregular slice spacing in " << directory << ": the gaps between slices "
-               << "deviate from their mean, " << Describe(sliceSpacing) << " mm, by up to "
-               << Describe(deviation) << " mm (at " << BaseName(worst)
-               << "); the volume is read with the mean spacing\n";
+               << "range from " << Describe(smallest) << " to " << Describe(largest) << " mm (mean "
+               << Describe(sliceSpacing) << " mm; largest deviation " << Describe(deviation)
+               << " mm, at " << BaseName(files[worst].Path)
+               << ", under 1%); the volume is read with the mean spacing\n";
     }
     // Positions off the normal through the first slice (a tilted gantry) cannot be represented.
     double offPlane = 0.0;
@@ -1050,8 +1068,7 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
         std::ifstream file(slice.Path, std::ios::binary);
         buffer.assign(padded, 0);
         file.seekg(static_cast<std::streamoff>(structure.PixelDataOffset));
-        decoded =
-          static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(padded)));
+        decoded = static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(padded)));
         if (swap)
         {
           for (std::size_t b = 0; b + word <= buffer.size(); b += word)

@@ -31,7 +31,8 @@ DEFECTS = {
     "orientation": "one file's ImageOrientationPatient differs",
     "pixel-spacing": "one file's PixelSpacing differs",
     "duplicate-position": "two files at the same ImagePositionPatient",
-    "irregular-spacing": "one slice moved by 0.3 slice spacings (a warning, not an error)",
+    "irregular-spacing": "one slice moved by 0.3 slice spacings (an error: not evenly spaced)",
+    "slightly-irregular-spacing": "one slice moved by 0.005 slice spacings (under 1%: a warning)",
     "image-size": "one file has one column fewer",
     "no-position": "one file lacks ImagePositionPatient",
     "second-series": "a second series of 3 files in the same directory (a warning)",
@@ -173,6 +174,8 @@ def write_series(args, volume, origin, spacing):
         rows, columns, pixels = ny, nx, stored[k]
         if args.defect == "irregular-spacing" and k == defect_slice:
             position = position + 0.3 * spacing[2] * normal
+        if args.defect == "slightly-irregular-spacing" and k == defect_slice:
+            position = position + 0.005 * spacing[2] * normal
         if args.defect == "duplicate-position" and k == defect_slice:
             position = np.asarray(origin) + (k - 1) * spacing[2] * normal
         if args.defect == "image-size" and k == defect_slice:
