@@ -655,6 +655,85 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
     warnings << "\n";
   }
 
+  // PASS 3a: one series may hold several stacks (localizers, other acquisitions under the same
+  // SeriesInstanceUID): images of one size, pixel format, orientation and pixel spacing form a
+  // stack; the largest is read (the first found on a tie) and the others are named.
+  std::string leftOut;
+  {
+    auto sameStack = [](const FileHeader& a, const FileHeader& b)
+    {
+      if (a.Rows != b.Rows || a.Columns != b.Columns || a.Samples != b.Samples ||
+        a.BitsAllocated != b.BitsAllocated || a.BitsStored != b.BitsStored ||
+        a.PixelRepresentation != b.PixelRepresentation || a.HasOrientation != b.HasOrientation ||
+        a.HasSpacing != b.HasSpacing)
+      {
+        return false;
+      }
+      for (int c = 0; c < 6; ++c)
+      {
+        if (std::fabs(a.Orientation[c] - b.Orientation[c]) > 1e-4)
+        {
+          return false;
+        }
+      }
+      return std::fabs(a.PixelSpacing[0] - b.PixelSpacing[0]) <= 1e-4 * b.PixelSpacing[0] &&
+        std::fabs(a.PixelSpacing[1] - b.PixelSpacing[1]) <= 1e-4 * b.PixelSpacing[1];
+    };
+    std::vector<std::vector<FileHeader>> stacks;
+    for (FileHeader& h : files)
+    {
+      auto stack = std::find_if(stacks.begin(), stacks.end(),
+        [&](const std::vector<FileHeader>& st) { return sameStack(h, st.front()); });
+      if (stack == stacks.end())
+      {
+        stacks.emplace_back();
+        stack = stacks.end() - 1;
+      }
+      stack->push_back(h);
+    }
+    if (stacks.size() > 1)
+    {
+      std::size_t largest = 0;
+      for (std::size_t st = 1; st < stacks.size(); ++st)
+      {
+        largest = stacks[st].size() > stacks[largest].size() ? st : largest;
+      }
+      const FileHeader& kept = stacks[largest].front();
+      warnings << "series " << chosenUID << " in " << directory << " mixes " << stacks.size()
+               << " stacks of images (localizers or other acquisitions): reading the largest, "
+               << stacks[largest].size() << " files of " << kept.Columns << " x " << kept.Rows
+               << " pixels; left out:";
+      std::ostringstream names;
+      for (std::size_t st = 0; st < stacks.size(); ++st)
+      {
+        if (st == largest)
+        {
+          continue;
+        }
+        const FileHeader& h = stacks[st].front();
+        warnings << " " << stacks[st].size() << " file" << (stacks[st].size() > 1 ? "s" : "")
+                 << " of " << h.Columns << " x " << h.Rows << " pixels, orientation ("
+                 << Describe(h.Orientation[0]);
+        for (int c = 1; c < 6; ++c)
+        {
+          warnings << ", " << Describe(h.Orientation[c]);
+        }
+        warnings << "), pixel spacing " << Describe(h.PixelSpacing[0]) << " x "
+                 << Describe(h.PixelSpacing[1]) << " mm (";
+        for (std::size_t f = 0; f < stacks[st].size(); ++f)
+        {
+          warnings << (f ? ", " : "") << BaseName(stacks[st][f].Path);
+          names << (names.str().empty() ? "" : ", ") << BaseName(stacks[st][f].Path);
+        }
+        warnings << ");";
+      }
+      warnings << "\n";
+      leftOut = names.str();
+      std::vector<FileHeader> chosen = std::move(stacks[largest]);
+      files.swap(chosen);
+    }
+  }
+
   // PASS 3: one volume's worth of consistency, each mismatch naming its file.
   const FileHeader& first = files.front();
   std::string problem;
@@ -853,7 +932,9 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
         " mm apart along the slice normal (at " + Describe(files[worst - 1].Projection) + " and " +
         Describe(files[worst].Projection) + " mm), the mean gap is " + Describe(sliceSpacing) +
         " mm (a missing slice, or a variable spacing); gaps range from " + Describe(smallest) +
-        " to " + Describe(largest) + " mm";
+        " to " + Describe(largest) + " mm" +
+        (leftOut.empty() ? std::string()
+                         : "; left out of this stack as another acquisition: " + leftOut);
       return false;
     }
     if (deviation > std::max(1e-3 * sliceSpacing, 1e-4))

@@ -36,6 +36,7 @@ DEFECTS = {
     "image-size": "one file has one column fewer",
     "no-position": "one file lacks ImagePositionPatient",
     "second-series": "a second series of 3 files in the same directory (a warning)",
+    "localizer": "two sagittal localizers of another size in the same series (a warning)",
     "transfer-syntax": "one file declares MPEG-2 (which GDCM does not decode)",
 }
 TRANSFER_SYNTAXES = ["explicit-little", "implicit-little", "explicit-big", "rle"]
@@ -200,6 +201,15 @@ def write_series(args, volume, origin, spacing):
             name = os.path.join(args.output, "IM%06d" % rng.randrange(1000000))
         ds.save_as(name, write_like_original=False)
         written.append(name)
+    if args.defect == "localizer":
+        # Sagittal images (rows along the head-foot axis) through the middle of the volume.
+        for k in range(2):
+            column = nx // 2 + k
+            position = np.asarray(origin) + column * spacing[0] * np.array([1.0, 0.0, 0.0])
+            ds = dataset(nz + k, series, nz, ny, np.ascontiguousarray(stored[:, :, column]), position)
+            ds.ImageOrientationPatient = ["0", "1", "0", "0", "0", "-1"]
+            ds.SeriesDescription = "RGMC localizer"
+            ds.save_as(os.path.join(args.output, "LOC%d" % k), write_like_original=False)
     if args.defect == "second-series":
         other = generate_uid(entropy_srcs=entropy + ["other series"])
         for k in range(min(3, nz)):

@@ -267,10 +267,18 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
     std::vector<std::string> Texts;
   };
   const std::vector<Defect> defects = {
-    { "orientation", { "/orientation/IM", "inconsistent orientation" } },
-    { "pixel-spacing", { "/pixel-spacing/IM", "inconsistent pixel spacing" } },
+    // A slice of another orientation, pixel spacing or size in the middle of the stack is left
+    // out as another acquisition, and the gap it leaves is the error.
+    { "orientation",
+      { "/orientation/IM", "not evenly spaced",
+        "left out of this stack as another acquisition: IM" } },
+    { "pixel-spacing",
+      { "/pixel-spacing/IM", "not evenly spaced",
+        "left out of this stack as another acquisition: IM" } },
     { "duplicate-position", { "/duplicate-position/IM", "same position" } },
-    { "image-size", { "/image-size/IM", "mixed image sizes" } },
+    { "image-size",
+      { "/image-size/IM", "not evenly spaced",
+        "left out of this stack as another acquisition: IM" } },
     { "no-position", { "/no-position/IM", "has no ImagePositionPatient" } },
     { "transfer-syntax", { "/transfer-syntax/IM", "unsupported transfer syntax", "MPEG" } },
     { "irregular-spacing",
@@ -284,6 +292,7 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
     }
     Generate(dir, npy, whole, "slightly-irregular-spacing", "--defect slightly-irregular-spacing");
     Generate(dir, npy, whole, "second-series", "--defect second-series");
+    Generate(dir, npy, whole, "localizer", "--defect localizer");
     Generate(dir, npy, whole, "truncated", "");
     fs::create_directories(dir + "/empty");
     fs::create_directories(dir + "/not-dicom");
@@ -315,6 +324,24 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
     if (rank == 0)
     {
       std::cout << "irregular spacing: " << ReaderMessage(r.Warnings) << "\n";
+    }
+  }
+  // Localizers in the series: the largest stack is read, the same volume as without them, with a
+  // warning that names the files left out.
+  {
+    vtkSmartPointer<vtkRGDICOMSeriesReader> reader = Reader(controller, dir + "/localizer");
+    PieceRead r = ReadPiece(reader, rank, ranks, 0);
+    RGMC_CHECK(r.Ok && r.Warnings.find("mixes 2 stacks of images") != std::string::npos &&
+        r.Warnings.find("LOC0") != std::string::npos &&
+        r.Warnings.find("LOC1") != std::string::npos,
+      "localizer: expected a warning naming LOC0 and LOC1, got [" << r.Warnings << "] "
+                                                                  << r.Errors);
+    RGMC_CHECK(reader->GetNumberOfFiles() == Dims[2],
+      "localizer: read " << reader->GetNumberOfFiles() << " files");
+    RGMC_CHECK(r.Ok && Mismatches(r.Image, whole) == 0, "localizer: the volume differs");
+    if (rank == 0)
+    {
+      std::cout << "localizer: " << ReaderMessage(r.Warnings) << "\n";
     }
   }
   // Two series: the larger is read with a warning listing the other; a UID picks one; an
