@@ -945,8 +945,10 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
                << " mm, at " << BaseName(files[worst].Path)
                << ", under 1%); the volume is read with the mean spacing\n";
     }
-    // Positions off the normal through the first slice (a tilted gantry) cannot be represented.
-    double offPlane = 0.0;
+    // Positions off the normal through the first slice cannot be represented: a stack sheared
+    // along its planes is a CT acquired with the gantry tilted. Said, with the tilt angle (the
+    // shift of the last slice against its distance along the normal).
+    double offPlane = 0.0, lastOff = 0.0;
     for (const FileHeader& h : files)
     {
       double d[3];
@@ -960,12 +962,15 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
         d[a] -= along * normal[a];
       }
       offPlane = std::max(offPlane, vtkMath::Norm(d));
+      lastOff = vtkMath::Norm(d);
     }
     if (offPlane > std::max(1e-3 * sliceSpacing, 1e-3))
     {
+      const double tilt = vtkMath::DegreesFromRadians(std::atan2(lastOff, extentAlong));
       warnings << "the slices of " << directory << " are shifted within their planes by up to "
-               << Describe(offPlane) << " mm (a tilted gantry?): the volume is read as if they "
-               << "were stacked along the normal\n";
+               << Describe(offPlane) << " mm: a gantry tilt of " << Describe(tilt)
+               << " degrees (or slices that do not line up); the volume is read as if they were "
+               << "stacked along the slice normal, so what it shows is sheared by that angle\n";
     }
     for (int a = 0; a < 3; ++a)
     {

@@ -36,6 +36,7 @@ DEFECTS = {
     "image-size": "one file has one column fewer",
     "no-position": "one file lacks ImagePositionPatient",
     "second-series": "a second series of 3 files in the same directory (a warning)",
+    "gantry-tilt": "slices sheared along their column direction by tan(12 degrees) per spacing (a warning)",
     "localizer": "two sagittal localizers of another size in the same series (a warning)",
     "transfer-syntax": "one file declares MPEG-2 (which GDCM does not decode)",
 }
@@ -175,6 +176,8 @@ def write_series(args, volume, origin, spacing):
         rows, columns, pixels = ny, nx, stored[k]
         if args.defect == "irregular-spacing" and k == defect_slice:
             position = position + 0.3 * spacing[2] * normal
+        if args.defect == "gantry-tilt":
+            position = position + k * spacing[2] * math.tan(math.radians(12.0)) * col
         if args.defect == "slightly-irregular-spacing" and k == defect_slice:
             position = position + 0.005 * spacing[2] * normal
         if args.defect == "duplicate-position" and k == defect_slice:

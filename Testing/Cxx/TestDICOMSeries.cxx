@@ -293,6 +293,7 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
     Generate(dir, npy, whole, "slightly-irregular-spacing", "--defect slightly-irregular-spacing");
     Generate(dir, npy, whole, "second-series", "--defect second-series");
     Generate(dir, npy, whole, "localizer", "--defect localizer");
+    Generate(dir, npy, whole, "gantry-tilt", "--defect gantry-tilt");
     Generate(dir, npy, whole, "truncated", "");
     fs::create_directories(dir + "/empty");
     fs::create_directories(dir + "/not-dicom");
@@ -324,6 +325,17 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
     if (rank == 0)
     {
       std::cout << "irregular spacing: " << ReaderMessage(r.Warnings) << "\n";
+    }
+  }
+  // A tilted gantry (slices sheared along their planes): said, with the angle; still read.
+  {
+    vtkSmartPointer<vtkRGDICOMSeriesReader> reader = Reader(controller, dir + "/gantry-tilt");
+    PieceRead r = ReadPiece(reader, rank, ranks, 0);
+    RGMC_CHECK(r.Ok && r.Warnings.find("a gantry tilt of 12 degrees") != std::string::npos,
+      "gantry tilt: expected a warning with its angle, got [" << r.Warnings << "] " << r.Errors);
+    if (rank == 0)
+    {
+      std::cout << "gantry tilt: " << ReaderMessage(r.Warnings) << "\n";
     }
   }
   // Localizers in the series: the largest stack is read, the same volume as without them, with a
