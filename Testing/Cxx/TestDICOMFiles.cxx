@@ -240,6 +240,42 @@ int main()
     }
   }
   {
+    // Structures scanners write, in pydicom's MR_small.dcm rewritten by pydicom itself
+    // (Testing/Python/dicom_quirks.py): a private sequence of undefined length with items of
+    // undefined length and a nested undefined-length sequence; a private element of odd length.
+    const std::string quirks = work + "/structures";
+    RGMC_CHECK(Run(std::string(RGMC_SYSTEM_PYTHON) + " " + RGMC_TESTING_PYTHON_DIR +
+                 "/dicom_quirks.py " + RGMC_PYDICOM_DIR + " " + quirks),
+      "dicom_quirks.py failed");
+    const std::vector<double> theirs = Samples(oracle + "/MR_small.dcm.f64");
+    for (const std::string name : { "undefined-length.dcm", "odd-length.dcm" })
+    {
+      const std::string dir = quirks + "/" + name + ".d";
+      fs::create_directories(dir);
+      fs::copy_file(quirks + "/" + name, dir + "/" + name, fs::copy_options::overwrite_existing);
+      vtkNew<vtkRGDICOMSeriesReader> reader;
+      reader->SetController(controller);
+      reader->SetFileName((dir + "/" + name).c_str());
+      PieceRead r = ReadPiece(reader, 0, 1, 0);
+      vtkIdType differ = -1;
+      if (r.Ok &&
+        r.Image->GetPointData()->GetScalars()->GetNumberOfValues() ==
+          static_cast<vtkIdType>(theirs.size()))
+      {
+        differ = 0;
+        for (vtkIdType n = 0; n < static_cast<vtkIdType>(theirs.size()); ++n)
+        {
+          differ += r.Image->GetPointData()->GetScalars()->GetComponent(n, 0) != theirs[n];
+        }
+      }
+      RGMC_CHECK(r.Ok && differ == 0,
+        "MR_small.dcm as " << name << ": "
+                           << (r.Ok ? std::to_string(differ) + " samples differ from pydicom's"
+                                    : ReaderMessage(r.Errors)));
+      std::cout << "read as pydicom decodes the original: MR_small.dcm as " << name << "\n";
+    }
+  }
+  {
     // No preamble, no "DICM", no file meta information: MR_small_implicit.dcm's bare data set
     // (implicit VR little endian), as older archives hold them.
     const std::string name = "MR_small_implicit.dcm";
