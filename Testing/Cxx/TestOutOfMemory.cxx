@@ -27,6 +27,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <string>
 
@@ -58,10 +59,33 @@ Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const st
   const bool limited = controller->GetLocalProcessId() == ranks - 1;
   struct rlimit saved;
   ::getrlimit(RLIMIT_AS, &saved);
+  // The heap keeps what earlier runs freed: small blocks would come from there, not from new
+  // address space, and the limit would not bind (measured on Debian sid, whose extraction and
+  // writer then never failed). So the free heap is filled first (a balloon of small blocks,
+  // freed after the run), and a stage's every allocation needs address space under the limit.
+  std::vector<void*> balloon;
   auto limit = [&](int stage)
   {
     if (limited && stage == limitStage)
     {
+      // Free chunks inside the heap (not its top, which grows the address space when used).
+      auto loose = []()
+      {
+        const struct mallinfo2 m = mallinfo2();
+        return m.fordblks - m.keepcost;
+      };
+      for (std::size_t block = 64 * 1024; block >= 64;)
+      {
+        const std::size_t before = loose();
+        void* p = std::malloc(block);
+        if (p && loose() < before)
+        {
+          balloon.push_back(p); // filled a hole
+          continue;
+        }
+        std::free(p); // no hole of this size left: smaller blocks
+        block /= 2;
+      }
       struct rlimit l = saved;
       l.rlim_cur = static_cast<rlim_t>(StatusBytes("VmSize:") + headroom);
       ::setrlimit(RLIMIT_AS, &l);
@@ -71,14 +95,19 @@ Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const st
   {
     bool Limited;
     struct rlimit Saved;
+    std::vector<void*>& Balloon;
     ~Restore()
     {
       if (this->Limited)
       {
         ::setrlimit(RLIMIT_AS, &this->Saved);
       }
+      for (void* p : this->Balloon)
+      {
+        std::free(p);
+      }
     }
-  } restore{ limited, saved };
+  } restore{ limited, saved, balloon };
   Run run;
   auto agreed = [&](rgmc_test::MessageCatcher* catcher, int stage)
   {
