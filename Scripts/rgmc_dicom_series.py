@@ -4,14 +4,16 @@
   /usr/bin/python3 Scripts/rgmc_dicom_series.py --volume hu.npy --spacing 1,1,1 \\
       --origin=-128,-128,-128 --output series/
 
-One file per slice (CT Image Storage), with shuffled file names and InstanceNumbers (a reader
-must sort by ImagePositionPatient), a rescale that reproduces every value exactly (the default,
-RescaleSlope 0.5 and RescaleIntercept -1024, stores 2 (HU + 1024)), and, with --oblique, an
-ImageOrientationPatient rotated about the axis --axis through the first voxel. Voxel (i, j, k)
-of the volume (numpy order [k, j, i]) lies at origin + R (i sx, j sy, k sz) in LPS patient
-coordinates, R the rotation; the phantom's origin and spacing are its own, so the series lands
-where the phantom's .vti does. --phantom needs ParaView (run with pvbatch); --volume needs only
-Debian's python3 with python3-numpy and python3-pydicom.
+One file per slice (CT Image Storage), with shuffled file names and InstanceNumbers that count
+down as the slice position goes up (instance 1 is the last slice along the normal, as scanners
+that number from the head write them: a reader must sort by ImagePositionPatient; dcm2niix, which
+stacks by InstanceNumber, converts the series right), a rescale that reproduces every value
+exactly (the default, RescaleSlope 0.5 and RescaleIntercept -1024, stores 2 (HU + 1024)), and,
+with --oblique, an ImageOrientationPatient rotated about the axis --axis through the first voxel.
+Voxel (i, j, k) of the volume (numpy order [k, j, i]) lies at origin + R (i sx, j sy, k sz) in
+LPS patient coordinates, R the rotation; the phantom's origin and spacing are its own, so the
+series lands where the phantom's .vti does. --phantom needs ParaView (run with pvbatch);
+--volume needs only Debian's python3 with python3-numpy and python3-pydicom.
 
 --defect writes a broken series on purpose, for the reader's error tests (see --help).
 """
@@ -120,8 +122,6 @@ def write_series(args, volume, origin, spacing):
     study = generate_uid(entropy_srcs=entropy + ["study"])
     series = generate_uid(entropy_srcs=entropy + ["series"])
     frame = generate_uid(entropy_srcs=entropy + ["frame"])
-    order = list(range(nz))
-    rng.shuffle(order)  # file names and instance numbers in a random order
     os.makedirs(args.output, exist_ok=True)
     ts = {"explicit-little": ExplicitVRLittleEndian, "implicit-little": ImplicitVRLittleEndian,
           "explicit-big": ExplicitVRBigEndian, "rle": RLELossless}[args.transfer_syntax]
@@ -145,7 +145,7 @@ def write_series(args, volume, origin, spacing):
         ds.FrameOfReferenceUID = frame
         ds.SeriesDescription = "RGMC CT phantom"
         ds.SeriesNumber = 1
-        ds.InstanceNumber = order[k] + 1 if k < nz else k + 1
+        ds.InstanceNumber = nz - k if k < nz else k + 1
         ds.ImagePositionPatient = [number(v) for v in position]
         ds.ImageOrientationPatient = [number(v) for v in list(row) + list(col)]
         ds.PixelSpacing = [number(spacing[1]), number(spacing[0])]  # row spacing, column spacing

@@ -1,13 +1,13 @@
 // vtkRGDICOMSeriesReader on 1 rank (vtkDummyController) and under mpiexec, on DICOM series that
 // the project's generator (Scripts/rgmc_dicom_series.py, run with Debian's python3 as a user
-// runs it) writes from the CT phantom with known geometry: axial, oblique, big endian, RLE,
-// rescale slopes 1, 0.5 and 0.25, shuffled file names. Each rank's piece must be a slab of
-// whole slices, decoded from its own files only, equal to the phantom's voxels at the same
-// indices exactly, placed with the geometry the generator was given; the union over ranks must
-// equal the 1-rank volume. Broken series (every case of the issue) must give the same message,
-// naming the file and the problem, on every rank (a gap in the spacing of 1% or more among
-// them); spacing irregular by less than 1% and a second series give warnings and the volume is
-// still read.
+// runs it) writes from the CT phantom with known geometry: axial, oblique, sagittal, big endian,
+// RLE (coronal), rescale slopes 1, 0.5 and 0.25, shuffled file names. Each rank's piece must be
+// a slab of whole slices, decoded from its own files only, equal to the phantom's voxels at the
+// same indices exactly, placed with the geometry the generator was given; the union over ranks
+// must equal the 1-rank volume. Broken series (every case of the issue) must give the same
+// message, naming the file and the problem, on every rank (a gap in the spacing of 1% or more
+// among them); spacing irregular by less than 1% and a second series give warnings and the
+// volume is still read. (TestDICOMGeometry checks the geometry against dcm2niix's.)
 #include "rgmcReaderTestData.h"
 #include "rgmcTestController.h"
 
@@ -46,6 +46,8 @@ std::vector<Series> AllSeries()
       { 1, 2, 3 } },
     { "rle", "--slope 1 --intercept -1024 --oblique 90 --axis 1,0,0 --transfer-syntax rle",
       VTK_SHORT, 90, { 1, 0, 0 } },
+    { "sagittal", "--slope 1 --intercept -1024 --oblique 90 --axis 0,1,0", VTK_SHORT, 90,
+      { 0, 1, 0 } },
   };
 }
 
