@@ -168,6 +168,12 @@ def write_series(args, volume, origin, spacing):
         ds.PixelData = data.tobytes()
         if ts == RLELossless:
             ds.compress(RLELossless, np.ascontiguousarray(pixels))
+            # An empty Basic Offset Table, as dcmtk and GDCM write one frame, instead of
+            # pydicom's single 0 offset (both valid; dcm2niix 1.0.20250506, Debian sid's,
+            # cannot decode the second: "RLE header corrupted").
+            one_offset = b"\xfe\xff\x00\xe0\x04\x00\x00\x00\x00\x00\x00\x00"
+            if ds.PixelData.startswith(one_offset):
+                ds.PixelData = b"\xfe\xff\x00\xe0\x00\x00\x00\x00" + ds.PixelData[12:]
         return ds
 
     written = []
