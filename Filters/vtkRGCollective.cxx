@@ -25,19 +25,46 @@ bool Ranks::Check(int status, const char* what)
 
 bool Ranks::Agree(bool ok, std::string& message)
 {
+  return this->Agree(ok, message, {}, {});
+}
+
+bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> anyOf,
+  std::initializer_list<int*> minimums)
+{
   if (ok && !this->Failure.empty())
   {
     ok = false;
     message = this->Failure;
   }
   this->Failure.clear();
-  int mine = ok ? this->Size : this->Rank, first = this->Size;
-  if (this->C->AllReduce(&mine, &first, 1, vtkCommunicator::MIN_OP) != 1)
+  // One MIN reduction: the first failing rank, 0 for a flag set somewhere, the minimums.
+  std::vector<int> mine, reduced(1 + anyOf.size() + minimums.size());
+  mine.push_back(ok ? this->Size : this->Rank);
+  for (const bool* flag : anyOf)
+  {
+    mine.push_back(*flag ? 0 : 1);
+  }
+  for (const int* value : minimums)
+  {
+    mine.push_back(*value);
+  }
+  if (this->C->AllReduce(mine.data(), reduced.data(), static_cast<vtkIdType>(mine.size()),
+        vtkCommunicator::MIN_OP) != 1)
   {
     // The agreement itself failed: nothing more can be trusted of the other ranks.
     message = "communication between the ranks failed (agreeing on a status)";
     return false;
   }
+  std::size_t n = 1;
+  for (bool* flag : anyOf)
+  {
+    *flag = reduced[n++] == 0;
+  }
+  for (int* value : minimums)
+  {
+    *value = reduced[n++];
+  }
+  const int first = reduced[0];
   if (first == this->Size)
   {
     return true;

@@ -8,6 +8,7 @@
 #include "vtkMultiProcessController.h"
 #include "vtkType.h"
 
+#include <initializer_list>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -26,6 +27,13 @@ public:
   /// last agreement. Otherwise every rank gets, in `message`, the message of the lowest failing
   /// rank.
   bool Agree(bool ok, std::string& message);
+
+  /// Agree, and in the same reduction: each of `anyOf` becomes true when it is true on some
+  /// rank, and each of `minimums` becomes its smallest value over the ranks (one collective call
+  /// where a status, flags and small reductions would otherwise take several). The values are
+  /// reduced even when the status fails.
+  bool Agree(bool ok, std::string& message, std::initializer_list<bool*> anyOf,
+    std::initializer_list<int*> minimums = {});
 
   /// Runs `work` (local work, no communication) unless `problem` is already set; an allocation
   /// failure becomes the problem "not enough memory to <what>". Then agrees, as Agree does.

@@ -3,7 +3,7 @@
 #include "vtkRGMarchingCubes.h"
 
 #include "rgmcCaseTable.h"
-#include "rgmcGrower.h"
+#include "rgmcSurfaceKernel.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 
@@ -121,6 +121,29 @@ struct Geometry
     vtkMath::Multiply3x3(inv, d, idx);
   }
 
+  /// World bounds of the volume of point extent `whole`.
+  void Bounds(const int whole[6], double bounds[6]) const
+  {
+    double m[3][4];
+    this->IndexToWorldMatrix(m);
+    for (int a = 0; a < 3; ++a)
+    {
+      bounds[2 * a] = VTK_DOUBLE_MAX;
+      bounds[2 * a + 1] = VTK_DOUBLE_MIN;
+    }
+    for (int c = 0; c < 8; ++c)
+    {
+      const double idx[3] = { double(whole[(c & 1) ? 1 : 0]), double(whole[(c & 2) ? 3 : 2]),
+        double(whole[(c & 4) ? 5 : 4]) };
+      for (int a = 0; a < 3; ++a)
+      {
+        const double x = m[a][0] * idx[0] + m[a][1] * idx[1] + m[a][2] * idx[2] + m[a][3];
+        bounds[2 * a] = std::min(bounds[2 * a], x);
+        bounds[2 * a + 1] = std::max(bounds[2 * a + 1], x);
+      }
+    }
+  }
+
   /// The smallest world length of a unit index step (smallest singular value).
   double MinStep() const
   {
@@ -223,19 +246,18 @@ rgmc::CellBox OwnedCells(vtkImageData* input)
 
 // ---- the kernel behind one interface, whatever the array type ------------------------------
 
-class AnyGrower
+class AnyKernel
 {
 public:
-  virtual ~AnyGrower() = default;
+  virtual ~AnyKernel() = default;
   virtual rgmc::SeedHit NearestVertex(
     const double idx[3], const double x[3], double radius, double minStep) = 0;
   virtual int GrowFromKey(std::int64_t key) = 0;
   virtual void GrowAll() = 0;
   virtual void GrowBoundary() = 0;
   virtual void Extract() = 0;
-  virtual int Root(int c) = 0;
   virtual rgmc::LocalMesh& Mesh() = 0;
-  virtual std::vector<rgmc::Component>& Components() = 0;
+  virtual rgmc::ComponentSet& Components() = 0;
   virtual std::vector<rgmc::Port>& Ports() = 0;
   virtual std::string Error() const = 0;
   virtual bool Aborted() const = 0;
@@ -243,35 +265,34 @@ public:
 };
 
 template <typename Range>
-class GrowerOf : public AnyGrower
+class KernelOf : public AnyKernel
 {
 public:
-  GrowerOf(const Range& values, const rgmc::Grid& grid, const rgmc::Ownership& own,
-    const rgmc::GrowerParams& params)
+  KernelOf(const Range& values, const rgmc::Grid& grid, const rgmc::Ownership& own,
+    const rgmc::SurfaceOptions& options)
     : Values(values)
-    , G(Cases(), grid, own, this->Values, params)
+    , Kernel(Cases(), grid, own, this->Values, options)
   {
   }
   rgmc::SeedHit NearestVertex(
     const double idx[3], const double x[3], double radius, double minStep) override
   {
-    return this->G.NearestVertex(idx, x, radius, minStep);
+    return this->Kernel.NearestVertex(idx, x, radius, minStep);
   }
-  int GrowFromKey(std::int64_t key) override { return this->G.GrowFromKey(key); }
-  void GrowAll() override { this->G.GrowAll(); }
-  void GrowBoundary() override { this->G.GrowBoundary(); }
-  void Extract() override { this->G.Extract(); }
-  int Root(int c) override { return this->G.Root(c); }
-  rgmc::LocalMesh& Mesh() override { return this->G.Mesh; }
-  std::vector<rgmc::Component>& Components() override { return this->G.Components; }
-  std::vector<rgmc::Port>& Ports() override { return this->G.Ports; }
-  std::string Error() const override { return this->G.Error(); }
-  bool Aborted() const override { return this->G.Aborted(); }
-  bool MissingGhosts() const override { return this->G.MissingGhosts(); }
+  int GrowFromKey(std::int64_t key) override { return this->Kernel.GrowFromKey(key); }
+  void GrowAll() override { this->Kernel.GrowAll(); }
+  void GrowBoundary() override { this->Kernel.GrowBoundary(); }
+  void Extract() override { this->Kernel.Extract(); }
+  rgmc::LocalMesh& Mesh() override { return this->Kernel.Mesh(); }
+  rgmc::ComponentSet& Components() override { return this->Kernel.Components; }
+  std::vector<rgmc::Port>& Ports() override { return this->Kernel.Ports(); }
+  std::string Error() const override { return this->Kernel.Error(); }
+  bool Aborted() const override { return this->Kernel.Aborted(); }
+  bool MissingGhosts() const override { return this->Kernel.MissingGhosts(); }
 
 private:
   Range Values;
-  rgmc::Grower<Range> G;
+  rgmc::SurfaceKernel<Range> Kernel;
 };
 
 /// Stands in for the samples on a rank that has none (it owns no cube, so nothing is read).
@@ -280,19 +301,19 @@ struct NoValues
   float operator[](std::int64_t) const { return 0.0f; }
 };
 
-struct MakeGrower
+struct MakeKernel
 {
   const rgmc::Grid* Grid;
   const rgmc::Ownership* Own;
-  const rgmc::GrowerParams* Params;
-  std::unique_ptr<AnyGrower> Result;
+  const rgmc::SurfaceOptions* Options;
+  std::unique_ptr<AnyKernel> Result;
 
   template <typename ArrayT>
   void operator()(ArrayT* array)
   {
     using Range = decltype(vtk::DataArrayValueRange<1>(array));
-    this->Result.reset(new GrowerOf<Range>(
-      vtk::DataArrayValueRange<1>(array), *this->Grid, *this->Own, *this->Params));
+    this->Result.reset(new KernelOf<Range>(
+      vtk::DataArrayValueRange<1>(array), *this->Grid, *this->Own, *this->Options));
   }
 };
 
@@ -307,26 +328,26 @@ struct Decision
 
 /// Joins the local components of all ranks through their ports and decides, on rank 0, which
 /// to keep. Collective; false on every rank (with `problem`) when it failed on one.
-bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc::Ownership& own,
+bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc::Ownership& own,
   int mode, std::vector<int>& rootIndex, Decision& decision, std::string& problem)
 {
-  std::vector<rgmc::Component>& comps = grower.Components();
+  rgmc::ComponentSet& comps = kernel.Components();
   std::vector<int> roots;
   if (!ranks.Step("join the components", problem,
         [&]()
         {
-          rootIndex.assign(comps.size(), -1);
-          for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+          rootIndex.assign(comps.Size(), -1);
+          for (int c = 0; c < comps.Size(); ++c)
           {
-            if (grower.Root(c) == c)
+            if (comps.Root(c) == c)
             {
               rootIndex[c] = static_cast<int>(roots.size());
               roots.push_back(c);
             }
           }
-          for (int c = 0; c < static_cast<int>(comps.size()); ++c)
+          for (int c = 0; c < comps.Size(); ++c)
           {
-            rootIndex[c] = rootIndex[grower.Root(c)];
+            rootIndex[c] = rootIndex[comps.Root(c)];
           }
         }))
   {
@@ -348,34 +369,29 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
   if (!ranks.Step("list the components' crossings", problem,
         [&]()
         {
-          for (const rgmc::Port& port : grower.Ports())
+          for (const rgmc::Port& port : kernel.Ports())
           {
             const vtkIdType gid = myOffset + rootIndex[port.Component];
             mine.emplace_back(port.Key, gid);
             int p[3], axis;
             grid.Decode(port.Key, p, axis);
             int sentTo[8], numSent = 0;
-            for (int d = 0; d < 8; ++d)
-            {
-              const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
-              if (axis >= 0 && o[axis] != 0)
+            rgmc::ForCubesAround(p, axis,
+              [&](int i, int j, int k, int)
               {
-                continue;
-              }
-              const int i = p[0] - o[0], j = p[1] - o[1], k = p[2] - o[2];
-              if (!grid.HasCell(i, j, k) || own.Owns(i, j, k))
-              {
-                continue;
-              }
-              const int owner = own.Owner(i, j, k);
-              if (owner < 0 || owner == ranks.Rank || std::count(sentTo, sentTo + numSent, owner))
-              {
-                continue;
-              }
-              sentTo[numSent++] = owner;
-              outgoing[owner].push_back(port.Key);
-              outgoing[owner].push_back(gid);
-            }
+                if (!grid.HasCell(i, j, k) || own.Owns(i, j, k))
+                {
+                  return;
+                }
+                const int owner = own.Owner(i, j, k);
+                if (owner < 0 || owner == ranks.Rank || std::count(sentTo, sentTo + numSent, owner))
+                {
+                  return;
+                }
+                sentTo[numSent++] = owner;
+                outgoing[owner].push_back(port.Key);
+                outgoing[owner].push_back(gid);
+              });
           }
         }))
   {
@@ -420,9 +436,10 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
           info.reserve(3 * roots.size());
           for (int c : roots)
           {
-            info.push_back(comps[c].Triangles);
-            info.push_back(comps[c].MinKey);
-            info.push_back(comps[c].Seeded ? 1 : 0);
+            const rgmc::ComponentSet::Totals& totals = comps.TotalsOf(c);
+            info.push_back(totals.Triangles);
+            info.push_back(totals.MinKey);
+            info.push_back(totals.Seeded ? 1 : 0);
           }
           for (const auto& e : edges)
           {
@@ -467,23 +484,12 @@ bool Resolve(Ranks& ranks, AnyGrower& grower, const rgmc::Grid& grid, const rgmc
           finalIds.assign(ranks.Rank == 0 ? total + 1 : 1, -1);
           if (ranks.Rank == 0)
           {
-            std::vector<vtkIdType> parent(total);
-            std::iota(parent.begin(), parent.end(), 0);
-            auto find = [&parent](vtkIdType x)
-            {
-              while (parent[x] != x)
-              {
-                x = parent[x] = parent[parent[x]];
-              }
-              return x;
-            };
+            rgmc::UnionFind<vtkIdType> sets;
+            sets.Reset(static_cast<std::size_t>(total));
+            auto find = [&sets](vtkIdType x) { return sets.Find(x); };
             for (vtkIdType n = 0; n + 1 < edgeOffsets[ranks.Size]; n += 2)
             {
-              const vtkIdType a = find(allEdges[n]), b = find(allEdges[n + 1]);
-              if (a != b)
-              {
-                parent[std::max(a, b)] = std::min(a, b);
-              }
+              sets.Unite(allEdges[n], allEdges[n + 1]);
             }
             struct Class
             {
@@ -641,169 +647,252 @@ int vtkRGMarchingCubes::RequestUpdateExtent(
 }
 
 //------------------------------------------------------------------------------
+/// What one execution carries from pass to pass on this rank.
+struct vtkRGMarchingCubes::Run
+{
+  explicit Run(vtkMultiProcessController* controller)
+    : ranks(controller)
+  {
+  }
+  Ranks ranks;
+  std::string problem; // the agreed error of a failed pass
+  int whole[6] = { 0, -1, 0, -1, 0, -1 };
+  bool hasPoints = false;
+  vtkDataArray* scalars = nullptr;
+  Geometry geometry;
+  int local[6] = { 0, -1, 0, -1, 0, -1 };
+  std::unique_ptr<rgmc::Ownership> own;
+  std::unique_ptr<rgmc::Grid> grid;
+  std::unique_ptr<AnyKernel> kernel;
+  std::vector<vtkIdType> seedKeys;
+  std::vector<double> seedPoints;
+  std::vector<int> rootIndex;
+  Decision decision;
+};
+
+//------------------------------------------------------------------------------
+// The collective schedule: every rank runs these passes in this order and makes the same
+// collective calls in each (an Agree is one reduction on success, a broadcast more on failure);
+// a pass that fails returns on every rank at the same point.
+//
+//  PASS 0 CheckInput       AllReduce (whole extent), Agree (status, any rank with points, the
+//                          lowest such rank), Broadcast (its geometry)
+//  PASS 1 AssignCubes      AllGather (owned and held cell boxes), Any (holes in the ownership)
+//  PASS 2 FindSeeds        Seeded mode only: Agree (seed outside the volume, NaN), 3 AllReduce
+//                          (nearest vertex: distance, key, position), GlobalRange when none
+//  PASS 3 GrowAndExtract   Agree (status, aborted, ghosts missing)
+//  PASS 4 Resolve          AllGather, Agree, Exchange (ports with neighbours), Agree, GatherV,
+//                          AllGather, Agree, GatherV, Agree, ScatterV, Broadcast, Agree
+//  PASS 5 StoreSurface     Agree
+//         DescribeSurface  GlobalRange when the surface is empty (2 AllReduce)
 int vtkRGMarchingCubes::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkImageData* input = vtkImageData::GetData(inputVector[0]);
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
   // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
   // SetAbortExecute would mark the filter modified and make it run again.
   this->AbortExecute = 0;
-
   vtkNew<vtkDummyController> single;
-  Ranks ranks(this->Controller ? this->Controller : single.Get());
+  Run run(this->Controller ? this->Controller : single.Get());
 
   // PASS 0: check the input on every rank and agree on the verdict.
-  std::string problem;
-  const bool hasPoints = input && input->GetNumberOfPoints() > 0;
+  if (!this->CheckInput(run, input, inputVector))
+  {
+    vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
+    return 0;
+  }
+  this->UpdateProgress(0.05);
+  // PASS 1: ownership of cubes.
+  this->AssignCubes(run, input);
+  // PASS 2: seeds, each to its nearest surface vertex over all ranks.
+  if (this->ExtractionMode == SEEDED)
+  {
+    const int found = this->FindSeeds(run);
+    if (found <= 0)
+    {
+      return found == 0 ? 1 : 0; // no surface near a seed (a warning), or an error
+    }
+  }
+  this->UpdateProgress(0.1);
+  // PASS 3: local growth and extraction, on every rank at once.
+  const int grown = this->GrowAndExtract(run);
+  if (grown <= 0)
+  {
+    output->Initialize();
+    return grown == 0 ? 1 : 0; // aborted, or an error
+  }
+  this->UpdateProgress(0.8);
+  // PASS 4: join components across ranks; decide what to keep.
+  if (!Resolve(run.ranks, *run.kernel, *run.grid, *run.own, this->ExtractionMode, run.rootIndex,
+        run.decision, run.problem))
+  {
+    vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
+    output->Initialize();
+    return 0;
+  }
+  this->UpdateProgress(0.9);
+  // PASS 5: the output piece.
+  if (!this->StoreSurface(run, output))
+  {
+    vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
+    output->Initialize();
+    return 0;
+  }
+  this->DescribeSurface(run, output);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGMarchingCubes::CheckInput(
+  Run& run, vtkImageData* input, vtkInformationVector** inputVector)
+{
+  Ranks& ranks = run.ranks;
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  run.hasPoints = input && input->GetNumberOfPoints() > 0;
   // The whole extent, agreed by all ranks: the union of what each rank was told and what it
-  // holds (pieces handed over without a pipeline know only their own extent).
-  int whole[6] = { 0, -1, 0, -1, 0, -1 };
+  // holds (pieces handed over without a pipeline know only their own extent). One MIN
+  // reduction of the lows and the negated highs.
   {
     int told[6] = { 0, -1, 0, -1, 0, -1 }, held[6] = { 0, -1, 0, -1, 0, -1 };
     if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
     {
       inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), told);
     }
-    if (hasPoints)
+    if (run.hasPoints)
     {
       input->GetExtent(held);
     }
-    int lows[3], highs[3];
+    int mine[6], agreed[6];
     for (int a = 0; a < 3; ++a)
     {
-      lows[a] = VTK_INT_MAX;
-      highs[a] = VTK_INT_MIN;
+      mine[a] = VTK_INT_MAX;
+      mine[3 + a] = VTK_INT_MAX; // -high
       for (const int* e : { told, held })
       {
         if (e[1] >= e[0] && e[3] >= e[2] && e[5] >= e[4])
         {
-          lows[a] = std::min(lows[a], e[2 * a]);
-          highs[a] = std::max(highs[a], e[2 * a + 1]);
+          mine[a] = std::min(mine[a], e[2 * a]);
+          mine[3 + a] = std::min(mine[3 + a], -e[2 * a + 1]);
         }
       }
     }
-    int agreedLows[3], agreedHighs[3];
-    ranks.Check(ranks.C->AllReduce(lows, agreedLows, 3, vtkCommunicator::MIN_OP), "a reduction");
-    ranks.Check(ranks.C->AllReduce(highs, agreedHighs, 3, vtkCommunicator::MAX_OP), "a reduction");
-    if (agreedLows[0] <= agreedHighs[0])
+    ranks.Check(ranks.C->AllReduce(mine, agreed, 6, vtkCommunicator::MIN_OP), "a reduction");
+    if (agreed[0] <= -agreed[3])
     {
       for (int a = 0; a < 3; ++a)
       {
-        whole[2 * a] = agreedLows[a];
-        whole[2 * a + 1] = agreedHighs[a];
+        run.whole[2 * a] = agreed[a];
+        run.whole[2 * a + 1] = -agreed[3 + a];
       }
     }
   }
-  vtkDataArray* scalars = nullptr;
+  const int* whole = run.whole;
+  std::ostringstream msg;
+  if (whole[1] < whole[0] || whole[3] < whole[2] || whole[5] < whole[4])
   {
-    std::ostringstream msg;
-    if (whole[1] < whole[0] || whole[3] < whole[2] || whole[5] < whole[4])
+    msg << "the input image is empty (whole extent " << whole[0] << " " << whole[1] << " "
+        << whole[2] << " " << whole[3] << " " << whole[4] << " " << whole[5] << ")";
+  }
+  else if (whole[1] == whole[0] || whole[3] == whole[2] || whole[5] == whole[4])
+  {
+    msg << "the input image is not a volume: its dimensions are " << whole[1] - whole[0] + 1
+        << " x " << whole[3] - whole[2] + 1 << " x " << whole[5] - whole[4] + 1
+        << "; marching cubes needs at least 2 samples along each axis";
+  }
+  else if (vtkMath::IsNan(this->Isovalue))
+  {
+    msg << "the isovalue is NaN";
+  }
+  else if (this->ExtractionMode == SEEDED && this->SeedPoints.empty())
+  {
+    msg << "no seed point is set: add one (SeedPoints = [x, y, z] in world coordinates) or "
+           "choose the Largest Component or All Components mode";
+  }
+  else if (run.hasPoints)
+  {
+    int association = vtkDataObject::FIELD_ASSOCIATION_POINTS;
+    vtkDataArray* scalars = this->GetInputArrayToProcess(0, inputVector, association);
+    vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
+    const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
+      ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+      : nullptr;
+    if (scalars && association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
     {
-      msg << "the input image is empty (whole extent " << whole[0] << " " << whole[1] << " "
-          << whole[2] << " " << whole[3] << " " << whole[4] << " " << whole[5] << ")";
+      msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "")
+          << "' is cell data; contouring needs point data (apply Cell Data to Point Data "
+             "first)";
     }
-    else if (whole[1] == whole[0] || whole[3] == whole[2] || whole[5] == whole[4])
+    else if (!scalars)
     {
-      msg << "the input image is not a volume: its dimensions are " << whole[1] - whole[0] + 1
-          << " x " << whole[3] - whole[2] + 1 << " x " << whole[5] - whole[4] + 1
-          << "; marching cubes needs at least 2 samples along each axis";
-    }
-    else if (vtkMath::IsNan(this->Isovalue))
-    {
-      msg << "the isovalue is NaN";
-    }
-    else if (this->ExtractionMode == SEEDED && this->SeedPoints.empty())
-    {
-      msg << "no seed point is set: add one (SeedPoints = [x, y, z] in world coordinates) or "
-             "choose the Largest Component or All Components mode";
-    }
-    else if (hasPoints)
-    {
-      int association = vtkDataObject::FIELD_ASSOCIATION_POINTS;
-      scalars = this->GetInputArrayToProcess(0, inputVector, association);
-      vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
-      const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
-        ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
-        : nullptr;
-      if (scalars && association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
+      if (name && input->GetCellData()->GetArray(name))
       {
-        msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "")
+        msg << "the array '" << name
             << "' is cell data; contouring needs point data (apply Cell Data to Point Data "
                "first)";
-        scalars = nullptr;
       }
-      else if (!scalars)
+      else if (name)
       {
-        if (name && input->GetCellData()->GetArray(name))
-        {
-          msg << "the array '" << name
-              << "' is cell data; contouring needs point data (apply Cell Data to Point Data "
-                 "first)";
-        }
-        else if (name)
-        {
-          msg << "the input has no point array named '" << name << "'";
-        }
-        else
-        {
-          msg << "the input has no point scalars to contour (it has "
-              << input->GetPointData()->GetNumberOfArrays() << " point arrays and "
-              << input->GetCellData()->GetNumberOfArrays()
-              << " cell arrays, none of them active point scalars)";
-        }
+        msg << "the input has no point array named '" << name << "'";
       }
-      else if (scalars->GetNumberOfComponents() != 1)
+      else
       {
-        msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "") << "' has "
-            << scalars->GetNumberOfComponents()
-            << " components; contour one component (extract it first, e.g. with Calculator)";
-        scalars = nullptr;
+        msg << "the input has no point scalars to contour (it has "
+            << input->GetPointData()->GetNumberOfArrays() << " point arrays and "
+            << input->GetCellData()->GetNumberOfArrays()
+            << " cell arrays, none of them active point scalars)";
       }
     }
-    problem = msg.str();
-  }
-  if (!ranks.Agree(problem.empty(), problem))
-  {
-    vtkErrorMacro(<< "Cannot extract a surface: " << problem << ".");
-    return 0;
-  }
-  {
-    // An empty image on every rank (each rank's piece is empty).
-    std::string empty = "the input image has no points";
-    if (!ranks.Agree(!ranks.Any(hasPoints) ? false : true, empty))
+    else if (scalars->GetNumberOfComponents() != 1)
     {
-      vtkErrorMacro(<< "Cannot extract a surface: " << empty << ".");
-      return 0;
+      msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "") << "' has "
+          << scalars->GetNumberOfComponents()
+          << " components; contour one component (extract it first, e.g. with Calculator)";
+    }
+    else
+    {
+      run.scalars = scalars;
     }
   }
-  this->UpdateProgress(0.05);
-
-  // Geometry, from the lowest rank that has data.
-  Geometry geom;
+  run.problem = msg.str();
+  // One agreement: the status, whether any rank has points, and the lowest rank that has, whose
+  // geometry everybody takes (a rank without data may carry default geometry).
+  bool anyPoints = run.hasPoints;
+  int source = run.hasPoints ? ranks.Rank : ranks.Size;
+  if (!ranks.Agree(run.problem.empty(), run.problem, { &anyPoints }, { &source }))
   {
-    int mine = hasPoints ? ranks.Rank : ranks.Size, source = ranks.Size;
-    ranks.Check(ranks.C->AllReduce(&mine, &source, 1, vtkCommunicator::MIN_OP), "a reduction");
-    double g[15];
-    if (ranks.Rank == source)
-    {
-      input->GetOrigin(g);
-      input->GetSpacing(g + 3);
-      const double* d = input->GetDirectionMatrix()->GetData();
-      std::copy_n(d, 9, g + 6);
-    }
-    ranks.Check(ranks.C->Broadcast(g, 15, source), "a broadcast");
-    std::copy_n(g, 3, geom.Origin);
-    std::copy_n(g + 3, 3, geom.Spacing);
-    std::copy_n(g + 6, 9, geom.Direction);
+    return false;
   }
+  if (!anyPoints)
+  {
+    run.problem = "the input image has no points"; // the same verdict on every rank
+    return false;
+  }
+  double g[15];
+  if (ranks.Rank == source)
+  {
+    input->GetOrigin(g);
+    input->GetSpacing(g + 3);
+    const double* d = input->GetDirectionMatrix()->GetData();
+    std::copy_n(d, 9, g + 6);
+  }
+  ranks.Check(ranks.C->Broadcast(g, 15, source), "a broadcast");
+  std::copy_n(g, 3, run.geometry.Origin);
+  std::copy_n(g + 3, 3, run.geometry.Spacing);
+  std::copy_n(g + 6, 9, run.geometry.Direction);
+  return true;
+}
 
-  // PASS 1: ownership of cubes.
-  int local[6] = { 0, -1, 0, -1, 0, -1 };
+//------------------------------------------------------------------------------
+void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
+{
+  Ranks& ranks = run.ranks;
+  const int* whole = run.whole;
+  int* local = run.local;
   rgmc::CellBox myCells;
-  if (hasPoints && scalars)
+  if (run.hasPoints && run.scalars)
   {
     input->GetExtent(local);
     myCells = OwnedCells(input);
@@ -848,7 +937,12 @@ int vtkRGMarchingCubes::RequestData(
         b.Hi[a] -= b.Hi[a] < whole[2 * a + 1] - 1 ? 1 : 0;
       }
     }
-    const bool trimmedCovers = !ranks.Any(!rgmc::Covers(trimmed, allMine));
+    // Covers() of the gathered boxes is the same on every rank: no reduction needed.
+    bool trimmedCovers = true;
+    for (const rgmc::CellBox& b : extentBoxes)
+    {
+      trimmedCovers = trimmedCovers && rgmc::Covers(trimmed, b);
+    }
     cellBoxes = trimmedCovers ? trimmed : extentBoxes;
     if (ranks.Rank == 0)
     {
@@ -858,172 +952,169 @@ int vtkRGMarchingCubes::RequestData(
                                         : ". Normals at the partition seams may be one-sided."));
     }
   }
-  const rgmc::Ownership own(cellBoxes, ranks.Rank);
-  const rgmc::Grid grid(whole, local);
+  run.own.reset(new rgmc::Ownership(cellBoxes, ranks.Rank));
+  run.grid.reset(new rgmc::Grid(whole, local));
 
-  rgmc::GrowerParams params;
-  params.Isovalue = this->Isovalue;
-  params.ComputeNormals = this->ComputeNormals;
-  params.DoublePoints = this->OutputPointsPrecision == DOUBLE_PRECISION;
-  geom.IndexToWorldMatrix(params.IndexToWorld);
-  geom.NormalMatrix(params.NormalToWorld);
-  params.Progress = [this](double fraction)
+  rgmc::SurfaceOptions options;
+  options.Isovalue = this->Isovalue;
+  options.ComputeNormals = this->ComputeNormals;
+  options.DoublePoints = this->OutputPointsPrecision == DOUBLE_PRECISION;
+  run.geometry.IndexToWorldMatrix(options.IndexToWorld);
+  run.geometry.NormalMatrix(options.NormalToWorld);
+  options.Progress = [this](double fraction)
   {
     this->UpdateProgress(0.1 + 0.7 * fraction);
     return this->CheckAbort();
   };
-  MakeGrower make{ &grid, &own, &params, nullptr };
-  if (scalars)
+  MakeKernel make{ run.grid.get(), run.own.get(), &options, nullptr };
+  if (run.scalars)
   {
-    if (!vtkArrayDispatch::Dispatch::Execute(scalars, make))
+    if (!vtkArrayDispatch::Dispatch::Execute(run.scalars, make))
     {
-      make(scalars); // any other array layout, through the generic API
+      make(run.scalars); // any other array layout, through the generic API
     }
   }
   else
   {
-    make.Result.reset(new GrowerOf<NoValues>(NoValues(), grid, own, params));
+    make.Result.reset(new KernelOf<NoValues>(NoValues(), *run.grid, *run.own, options));
   }
-  AnyGrower& grower = *make.Result;
+  run.kernel = std::move(make.Result);
+}
 
-  // PASS 2: seeds, each to its nearest surface vertex over all ranks.
+//------------------------------------------------------------------------------
+int vtkRGMarchingCubes::FindSeeds(Run& run)
+{
+  Ranks& ranks = run.ranks;
+  const int* whole = run.whole;
+  const Geometry& geom = run.geometry;
   const int numSeeds = this->GetNumberOfSeedPoints();
-  std::vector<vtkIdType> seedKeys;
-  std::vector<double> seedPoints;
-  if (this->ExtractionMode == SEEDED)
+  // Every seed must lie in the volume (the same verdict on every rank: the geometry is agreed).
+  std::ostringstream outside;
+  std::vector<double> seedIndex(3 * numSeeds);
+  for (int s = 0; s < numSeeds && outside.str().empty(); ++s)
   {
-    std::ostringstream msg;
-    double bounds[6];
+    double* q = &seedIndex[3 * s];
+    geom.WorldToIndex(&this->SeedPoints[3 * s], q);
     for (int a = 0; a < 3; ++a)
     {
-      bounds[2 * a] = VTK_DOUBLE_MAX;
-      bounds[2 * a + 1] = VTK_DOUBLE_MIN;
-    }
-    double m[3][4];
-    geom.IndexToWorldMatrix(m);
-    for (int c = 0; c < 8; ++c)
-    {
-      const double idx[3] = { double(whole[(c & 1) ? 1 : 0]), double(whole[(c & 2) ? 3 : 2]),
-        double(whole[(c & 4) ? 5 : 4]) };
-      for (int a = 0; a < 3; ++a)
+      const double tolerance = 1e-6 * (1.0 + std::fabs(whole[2 * a + 1]));
+      if (!(q[a] >= whole[2 * a] - tolerance && q[a] <= whole[2 * a + 1] + tolerance))
       {
-        const double x = m[a][0] * idx[0] + m[a][1] * idx[1] + m[a][2] * idx[2] + m[a][3];
-        bounds[2 * a] = std::min(bounds[2 * a], x);
-        bounds[2 * a + 1] = std::max(bounds[2 * a + 1], x);
+        double bounds[6];
+        geom.Bounds(whole, bounds);
+        outside << "seed point " << s << " (" << this->SeedPoints[3 * s] << ", "
+                << this->SeedPoints[3 * s + 1] << ", " << this->SeedPoints[3 * s + 2]
+                << ") lies outside the volume, whose bounds are [" << bounds[0] << ", " << bounds[1]
+                << "] x [" << bounds[2] << ", " << bounds[3] << "] x [" << bounds[4] << ", "
+                << bounds[5] << "]";
+        break;
       }
     }
-    std::vector<double> seedIndex(3 * numSeeds);
-    for (int s = 0; s < numSeeds && msg.str().empty(); ++s)
-    {
-      double* q = &seedIndex[3 * s];
-      geom.WorldToIndex(&this->SeedPoints[3 * s], q);
-      for (int a = 0; a < 3; ++a)
-      {
-        const double tolerance = 1e-6 * (1.0 + std::fabs(whole[2 * a + 1]));
-        if (!(q[a] >= whole[2 * a] - tolerance && q[a] <= whole[2 * a + 1] + tolerance))
-        {
-          msg << "seed point " << s << " (" << this->SeedPoints[3 * s] << ", "
-              << this->SeedPoints[3 * s + 1] << ", " << this->SeedPoints[3 * s + 2]
-              << ") lies outside the volume, whose bounds are [" << bounds[0] << ", " << bounds[1]
-              << "] x [" << bounds[2] << ", " << bounds[3] << "] x [" << bounds[4] << ", "
-              << bounds[5] << "]";
-          break;
-        }
-      }
-    }
-    std::string outside = msg.str();
-    if (!ranks.Agree(outside.empty(), outside))
-    {
-      vtkWarningMacro(<< "No surface extracted: " << outside << ".");
-      return 1;
-    }
-
-    std::vector<double> d2(numSeeds), bestD2(numSeeds);
-    std::vector<rgmc::SeedHit> hits(numSeeds);
+  }
+  // Each rank's nearest vertex to each seed; a NaN met on the way is an error.
+  std::vector<rgmc::SeedHit> hits(numSeeds);
+  bool isOutside = !outside.str().empty();
+  if (!isOutside)
+  {
     const double minStep = geom.MinStep();
     for (int s = 0; s < numSeeds; ++s)
     {
-      hits[s] = grower.NearestVertex(
+      hits[s] = run.kernel->NearestVertex(
         &seedIndex[3 * s], &this->SeedPoints[3 * s], this->SeedSearchRadius, minStep);
-      d2[s] = hits[s].Distance2;
     }
-    std::string error = grower.Error();
-    if (!ranks.Agree(error.empty(), error))
+  }
+  run.problem = isOutside ? outside.str() : run.kernel->Error();
+  if (!ranks.Agree(run.problem.empty(), run.problem, { &isOutside }))
+  {
+    if (isOutside)
     {
-      vtkErrorMacro(<< "Cannot extract a surface: " << error << ".");
+      vtkWarningMacro(<< "No surface extracted: " << run.problem << ".");
       return 0;
     }
-    ranks.Check(ranks.C->AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP),
-      "a reduction");
-    std::vector<vtkIdType> keys(numSeeds), bestKeys(numSeeds);
-    for (int s = 0; s < numSeeds; ++s)
-    {
-      keys[s] = hits[s].Found && hits[s].Distance2 == bestD2[s]
-        ? hits[s].Key
-        : std::numeric_limits<vtkIdType>::max();
-    }
-    ranks.Check(ranks.C->AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP),
-      "a reduction");
-    std::vector<double> points(3 * numSeeds), bestPoints(3 * numSeeds);
-    for (int s = 0; s < numSeeds; ++s)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        points[3 * s + a] =
-          hits[s].Found && hits[s].Key == bestKeys[s] ? hits[s].Point[a] : VTK_DOUBLE_MAX;
-      }
-    }
-    ranks.Check(
-      ranks.C->AllReduce(points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP),
-      "a reduction");
-    for (int s = 0; s < numSeeds; ++s)
-    {
-      if (bestKeys[s] == std::numeric_limits<vtkIdType>::max())
-      {
-        double range[2];
-        GlobalRange(ranks, scalars, range);
-        std::ostringstream why;
-        if (this->Isovalue > range[1] || this->Isovalue <= range[0])
-        {
-          why << "the isovalue " << this->Isovalue << " is outside the data range [" << range[0]
-              << ", " << range[1] << "], so there is no surface at all";
-        }
-        else
-        {
-          why << "no surface at isovalue " << this->Isovalue << " passes within "
-              << this->SeedSearchRadius << " of seed point " << s << " (" << this->SeedPoints[3 * s]
-              << ", " << this->SeedPoints[3 * s + 1] << ", " << this->SeedPoints[3 * s + 2]
-              << "); move the seed onto the structure or raise SeedSearchRadius";
-        }
-        vtkWarningMacro(<< "No surface extracted: " << why.str() << ".");
-        return 1;
-      }
-    }
-    seedKeys = bestKeys;
-    seedPoints = bestPoints;
+    vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
+    return -1;
   }
-  this->UpdateProgress(0.1);
+  // The global nearest: smallest distance, then smallest key, then its position.
+  std::vector<double> d2(numSeeds), bestD2(numSeeds);
+  for (int s = 0; s < numSeeds; ++s)
+  {
+    d2[s] = hits[s].Distance2;
+  }
+  ranks.Check(
+    ranks.C->AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP), "a reduction");
+  std::vector<vtkIdType> keys(numSeeds), bestKeys(numSeeds);
+  for (int s = 0; s < numSeeds; ++s)
+  {
+    keys[s] = hits[s].Found && hits[s].Distance2 == bestD2[s]
+      ? hits[s].Key
+      : std::numeric_limits<vtkIdType>::max();
+  }
+  ranks.Check(ranks.C->AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP),
+    "a reduction");
+  std::vector<double> points(3 * numSeeds), bestPoints(3 * numSeeds);
+  for (int s = 0; s < numSeeds; ++s)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      points[3 * s + a] =
+        hits[s].Found && hits[s].Key == bestKeys[s] ? hits[s].Point[a] : VTK_DOUBLE_MAX;
+    }
+  }
+  ranks.Check(
+    ranks.C->AllReduce(points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP),
+    "a reduction");
+  for (int s = 0; s < numSeeds; ++s)
+  {
+    if (bestKeys[s] == std::numeric_limits<vtkIdType>::max())
+    {
+      double range[2];
+      GlobalRange(ranks, run.scalars, range);
+      std::ostringstream why;
+      if (this->Isovalue > range[1] || this->Isovalue <= range[0])
+      {
+        why << "the isovalue " << this->Isovalue << " is outside the data range [" << range[0]
+            << ", " << range[1] << "], so there is no surface at all";
+      }
+      else
+      {
+        why << "no surface at isovalue " << this->Isovalue << " passes within "
+            << this->SeedSearchRadius << " of seed point " << s << " (" << this->SeedPoints[3 * s]
+            << ", " << this->SeedPoints[3 * s + 1] << ", " << this->SeedPoints[3 * s + 2]
+            << "); move the seed onto the structure or raise SeedSearchRadius";
+      }
+      vtkWarningMacro(<< "No surface extracted: " << why.str() << ".");
+      return 0;
+    }
+  }
+  run.seedKeys = bestKeys;
+  run.seedPoints = bestPoints;
+  return 1;
+}
 
-  // PASS 3: local growth, on every rank at once.
+//------------------------------------------------------------------------------
+int vtkRGMarchingCubes::GrowAndExtract(Run& run)
+{
+  Ranks& ranks = run.ranks;
+  AnyKernel& kernel = *run.kernel;
   std::string outOfMemory;
   try
   {
     if (this->ExtractionMode == SEEDED)
     {
-      for (vtkIdType key : seedKeys)
+      for (vtkIdType key : run.seedKeys)
       {
-        grower.GrowFromKey(key); // seeded components; before the boundary growth
+        kernel.GrowFromKey(key); // seeded components; before the boundary growth
       }
       if (ranks.Size > 1)
       {
-        grower.GrowBoundary();
+        kernel.GrowBoundary();
       }
     }
     else
     {
-      grower.GrowAll();
+      kernel.GrowAll();
     }
-    grower.Extract();
+    kernel.Extract();
   }
   catch (const std::length_error& tooMany)
   {
@@ -1033,157 +1124,149 @@ int vtkRGMarchingCubes::RequestData(
   catch (const std::bad_alloc&)
   {
     outOfMemory = "not enough memory to grow and extract the surface on rank " +
-      std::to_string(ranks.Rank) + " (" + std::to_string(grower.Mesh().NumberOfTriangles()) +
+      std::to_string(ranks.Rank) + " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) +
       " triangles so far)";
   }
+  run.problem = outOfMemory.empty() ? kernel.Error() : outOfMemory;
+  bool aborted = kernel.Aborted(), missingGhosts = kernel.MissingGhosts();
+  if (!ranks.Agree(run.problem.empty(), run.problem, { &aborted, &missingGhosts }))
   {
-    std::string error = outOfMemory.empty() ? grower.Error() : outOfMemory;
-    if (!ranks.Agree(error.empty(), error))
-    {
-      vtkErrorMacro(<< "Cannot extract a surface: " << error << ".");
-      return 0;
-    }
-    if (ranks.Any(grower.Aborted()))
-    {
-      output->Initialize();
-      return 1;
-    }
-    if (ranks.Any(grower.MissingGhosts()) && ranks.Rank == 0)
-    {
-      vtkWarningMacro(<< "The input pieces have no ghost layer: normals at the partition seams "
-                         "are one-sided there and differ from a 1-rank run.");
-    }
+    vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
+    return -1;
   }
-  this->UpdateProgress(0.8);
-
-  // PASS 4: join components across ranks; decide what to keep.
-  std::vector<int> rootIndex;
-  Decision decision;
-  if (!Resolve(ranks, grower, grid, own, this->ExtractionMode, rootIndex, decision, problem))
+  if (aborted)
   {
-    vtkErrorMacro(<< "Cannot extract a surface: " << problem << ".");
-    output->Initialize();
     return 0;
   }
-  this->UpdateProgress(0.9);
+  if (missingGhosts && ranks.Rank == 0)
+  {
+    vtkWarningMacro(<< "The input pieces have no ghost layer: normals at the partition seams "
+                       "are one-sided there and differ from a 1-rank run.");
+  }
+  return 1;
+}
 
-  // PASS 5: the output piece. The kernel's buffers become the output arrays without copies.
+//------------------------------------------------------------------------------
+bool vtkRGMarchingCubes::StoreSurface(Run& run, vtkPolyData* output)
+{
   output->Initialize();
-  if (!ranks.Step("store the surface", problem,
-        [&]()
+  // The kernel's buffers become the output arrays without copies.
+  return run.ranks.Step("store the surface", run.problem,
+    [&]()
+    {
+      const Decision& decision = run.decision;
+      const std::vector<int>& rootIndex = run.rootIndex;
+      rgmc::LocalMesh& mesh = run.kernel->Mesh();
+      mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
+      const vtkIdType numPoints = mesh.NumberOfPoints();
+      const vtkIdType numKept = mesh.NumberOfTriangles();
+      for (std::int32_t& comp : mesh.TriangleComponent)
+      {
+        comp = static_cast<std::int32_t>(decision.FinalId[rootIndex[comp]]);
+      }
+
+      vtkNew<vtkPoints> points;
+      if (this->OutputPointsPrecision == DOUBLE_PRECISION)
+      {
+        vtkNew<vtkDoubleArray> xyz;
+        xyz->SetNumberOfComponents(3);
+        xyz->SetArray(
+          mesh.PointsDouble.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+        points->SetData(xyz);
+      }
+      else
+      {
+        vtkNew<vtkFloatArray> xyz;
+        xyz->SetNumberOfComponents(3);
+        xyz->SetArray(
+          mesh.Points.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+        points->SetData(xyz);
+      }
+      vtkNew<vtkFloatArray> normals;
+      normals->SetName("Normals");
+      normals->SetNumberOfComponents(3);
+      if (this->ComputeNormals)
+      {
+        normals->SetArray(
+          mesh.Normals.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+      }
+      vtkNew<vtkIdTypeArray> keys;
+      keys->SetName("VertexKey");
+      static_assert(sizeof(vtkIdType) == sizeof(long long), "vertex keys are 64-bit ids");
+      keys->SetArray(reinterpret_cast<vtkIdType*>(mesh.Keys.Release()), numPoints, 0,
+        vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+
+      // Triangles: the kernel's 32-bit connectivity, adopted as is; 64-bit when a rank has more
+      // than 2^31 - 1 corners, where 32-bit offsets would overflow.
+      vtkNew<vtkCellArray> polys;
+      if (3 * numKept <= VTK_TYPE_INT32_MAX)
+      {
+        vtkNew<vtkTypeInt32Array> offsets, connectivity;
+        std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
+        for (vtkIdType n = 0; n <= numKept; ++n)
         {
-          rgmc::LocalMesh& mesh = grower.Mesh();
-          mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
-          const vtkIdType numPoints = mesh.NumberOfPoints();
-          const vtkIdType numKept = mesh.NumberOfTriangles();
-          for (std::int32_t& comp : mesh.TriangleComponent)
-          {
-            comp = static_cast<std::int32_t>(decision.FinalId[rootIndex[comp]]);
-          }
+          o[n] = static_cast<std::int32_t>(3 * n);
+        }
+        connectivity->SetArray(
+          mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+        polys->SetData(offsets, connectivity);
+      }
+      else
+      {
+        vtkNew<vtkTypeInt64Array> offsets, connectivity;
+        vtkTypeInt64* o = rgmc::Allocate(offsets.Get(), numKept + 1);
+        for (vtkIdType n = 0; n <= numKept; ++n)
+        {
+          o[n] = 3 * n;
+        }
+        std::copy(mesh.Triangles.begin(), mesh.Triangles.begin() + 3 * numKept,
+          rgmc::Allocate(connectivity.Get(), 3 * numKept));
+        std::free(mesh.Triangles.Release());
+        polys->SetData(offsets, connectivity);
+      }
+      vtkNew<vtkIntArray> componentIds;
+      componentIds->SetName("ComponentId");
+      static_assert(sizeof(int) == sizeof(std::int32_t), "component ids are 32-bit");
+      componentIds->SetArray(reinterpret_cast<int*>(mesh.TriangleComponent.Release()), numKept, 0,
+        vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+      vtkNew<vtkIntArray> rankIds;
+      rankIds->SetName("RankId");
+      std::fill_n(rgmc::Allocate(rankIds.Get(), numKept), numKept, run.ranks.Rank);
 
-          vtkNew<vtkPoints> points;
-          if (this->OutputPointsPrecision == DOUBLE_PRECISION)
-          {
-            vtkNew<vtkDoubleArray> xyz;
-            xyz->SetNumberOfComponents(3);
-            xyz->SetArray(
-              mesh.PointsDouble.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-            points->SetData(xyz);
-          }
-          else
-          {
-            vtkNew<vtkFloatArray> xyz;
-            xyz->SetNumberOfComponents(3);
-            xyz->SetArray(
-              mesh.Points.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-            points->SetData(xyz);
-          }
-          vtkNew<vtkFloatArray> normals;
-          normals->SetName("Normals");
-          normals->SetNumberOfComponents(3);
-          if (this->ComputeNormals)
-          {
-            normals->SetArray(
-              mesh.Normals.Release(), 3 * numPoints, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-          }
-          vtkNew<vtkIdTypeArray> keys;
-          keys->SetName("VertexKey");
-          static_assert(sizeof(vtkIdType) == sizeof(long long), "vertex keys are 64-bit ids");
-          keys->SetArray(reinterpret_cast<vtkIdType*>(mesh.Keys.Release()), numPoints, 0,
-            vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+      output->SetPoints(points);
+      output->SetPolys(polys);
+      if (this->ComputeNormals)
+      {
+        output->GetPointData()->SetNormals(normals);
+      }
+      output->GetPointData()->SetGlobalIds(keys);
+      output->GetCellData()->AddArray(rankIds);
+      // No active scalars: ParaView shows the surface in one colour, as Contour's; colouring by
+      // RankId (the decomposition) or ComponentId is the user's choice.
+      output->GetCellData()->AddArray(componentIds);
+    });
+}
 
-          // Triangles: the kernel's 32-bit connectivity, adopted as is; 64-bit when a rank has more
-          // than 2^31 - 1 corners, where 32-bit offsets would overflow.
-          vtkNew<vtkCellArray> polys;
-          if (3 * numKept <= VTK_TYPE_INT32_MAX)
-          {
-            vtkNew<vtkTypeInt32Array> offsets, connectivity;
-            std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-            for (vtkIdType n = 0; n <= numKept; ++n)
-            {
-              o[n] = static_cast<std::int32_t>(3 * n);
-            }
-            connectivity->SetArray(
-              mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-            polys->SetData(offsets, connectivity);
-          }
-          else
-          {
-            vtkNew<vtkTypeInt64Array> offsets, connectivity;
-            vtkTypeInt64* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-            for (vtkIdType n = 0; n <= numKept; ++n)
-            {
-              o[n] = 3 * n;
-            }
-            std::copy(mesh.Triangles.begin(), mesh.Triangles.begin() + 3 * numKept,
-              rgmc::Allocate(connectivity.Get(), 3 * numKept));
-            std::free(mesh.Triangles.Release());
-            polys->SetData(offsets, connectivity);
-          }
-          vtkNew<vtkIntArray> componentIds;
-          componentIds->SetName("ComponentId");
-          static_assert(sizeof(int) == sizeof(std::int32_t), "component ids are 32-bit");
-          componentIds->SetArray(reinterpret_cast<int*>(mesh.TriangleComponent.Release()), numKept,
-            0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
-          vtkNew<vtkIntArray> rankIds;
-          rankIds->SetName("RankId");
-          std::fill_n(rgmc::Allocate(rankIds.Get(), numKept), numKept, ranks.Rank);
-
-          output->SetPoints(points);
-          output->SetPolys(polys);
-          if (this->ComputeNormals)
-          {
-            output->GetPointData()->SetNormals(normals);
-          }
-          output->GetPointData()->SetGlobalIds(keys);
-          output->GetCellData()->AddArray(rankIds);
-          // No active scalars: ParaView shows the surface in one colour, as Contour's; colouring by
-          // RankId (the decomposition) or ComponentId is the user's choice.
-          output->GetCellData()->AddArray(componentIds);
-        }))
-  {
-    vtkErrorMacro(<< "Cannot extract a surface: " << problem << ".");
-    output->Initialize();
-    return 0;
-  }
-
+//------------------------------------------------------------------------------
+void vtkRGMarchingCubes::DescribeSurface(Run& run, vtkPolyData* output)
+{
   vtkNew<vtkIdTypeArray> seedKeyArray;
   seedKeyArray->SetName("SeedVertexKeys");
   vtkNew<vtkDoubleArray> seedPointArray;
   seedPointArray->SetName("SeedVertexPoints");
   seedPointArray->SetNumberOfComponents(3);
-  for (std::size_t s = 0; s < seedKeys.size(); ++s)
+  for (std::size_t s = 0; s < run.seedKeys.size(); ++s)
   {
-    seedKeyArray->InsertNextValue(seedKeys[s]);
-    seedPointArray->InsertNextTuple(&seedPoints[3 * s]);
+    seedKeyArray->InsertNextValue(run.seedKeys[s]);
+    seedPointArray->InsertNextTuple(&run.seedPoints[3 * s]);
   }
   vtkNew<vtkIdTypeArray> triangleCount;
   triangleCount->SetName("NumberOfTriangles");
-  triangleCount->InsertNextValue(decision.Triangles);
+  triangleCount->InsertNextValue(run.decision.Triangles);
   vtkNew<vtkIdTypeArray> componentCount;
   componentCount->SetName("NumberOfComponents");
-  componentCount->InsertNextValue(decision.Components);
-  if (!seedKeys.empty()) // empty arrays would hide the field data from ParaView's information
+  componentCount->InsertNextValue(run.decision.Components);
+  if (!run.seedKeys.empty()) // empty arrays would hide the field data from ParaView's information
   {
     output->GetFieldData()->AddArray(seedKeyArray);
     output->GetFieldData()->AddArray(seedPointArray);
@@ -1194,26 +1277,22 @@ int vtkRGMarchingCubes::RequestData(
   wholeExtent->SetNumberOfValues(6);
   for (int i = 0; i < 6; ++i)
   {
-    wholeExtent->SetValue(i, whole[i]);
+    wholeExtent->SetValue(i, run.whole[i]);
   }
   output->GetFieldData()->AddArray(wholeExtent);
   output->GetFieldData()->AddArray(componentCount);
 
-  if (decision.Triangles == 0 && ranks.Rank == 0)
+  if (run.decision.Triangles == 0)
   {
     double range[2];
-    GlobalRange(ranks, scalars, range);
-    vtkWarningMacro(<< "No surface extracted: the isovalue " << this->Isovalue
-                    << " gives no triangles (data range [" << range[0] << ", " << range[1]
-                    << "]).");
+    GlobalRange(run.ranks, run.scalars, range);
+    if (run.ranks.Rank == 0)
+    {
+      vtkWarningMacro(<< "No surface extracted: the isovalue " << this->Isovalue
+                      << " gives no triangles (data range [" << range[0] << ", " << range[1]
+                      << "]).");
+    }
   }
-  else if (decision.Triangles == 0)
-  {
-    double range[2];
-    GlobalRange(ranks, scalars, range);
-  }
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -67,6 +67,7 @@
 
 #include <vector> // For the seed points
 
+class vtkImageData;
 class vtkMultiProcessController;
 
 class RGMCFILTERS_EXPORT vtkRGMarchingCubes : public vtkPolyDataAlgorithm
@@ -168,6 +169,18 @@ protected:
 private:
   vtkRGMarchingCubes(const vtkRGMarchingCubes&) = delete;
   void operator=(const vtkRGMarchingCubes&) = delete;
+
+  // The passes of RequestData, each collective (the schedule is written down there). A pass
+  // that fails leaves the agreed message in the run.
+  struct Run;
+  bool CheckInput(Run& run, vtkImageData* input, vtkInformationVector** inputVector);
+  void AssignCubes(Run& run, vtkImageData* input);
+  /// 1: every seed has a vertex; 0: no surface near a seed (warned); -1: an error.
+  int FindSeeds(Run& run);
+  /// 1: done; 0: aborted; -1: an error.
+  int GrowAndExtract(Run& run);
+  bool StoreSurface(Run& run, vtkPolyData* output);
+  void DescribeSurface(Run& run, vtkPolyData* output);
 };
 
 #endif

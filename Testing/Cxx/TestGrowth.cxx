@@ -2,7 +2,7 @@
 // owners (whose union must be the whole), and of its cost: seeded growth reads samples near the
 // surface only, so the same surface in a larger volume costs exactly the same reads.
 #include "rgmcCheck.h"
-#include "rgmcGrower.h"
+#include "rgmcSurfaceKernel.h"
 
 #include "vtkMarchingCubesTriangleCases.h"
 
@@ -98,34 +98,35 @@ void OneCorner()
   vol.At(0, 0, 0) = 1.0f;
   const rgmc::Grid grid(vol.Extent, vol.Extent);
   const rgmc::Ownership own = OwnAll(grid);
-  rgmc::GrowerParams params;
+  rgmc::SurfaceOptions params;
   params.Isovalue = 0.5;
   const std::vector<float>& values = vol.Values;
-  rgmc::Grower<std::vector<float>> g(Table(), grid, own, values, params);
+  rgmc::SurfaceKernel<std::vector<float>> g(Table(), grid, own, values, params);
   const int comp = g.GrowFromKey(grid.EdgeKey(0, 0, 0, 0));
   g.Extract();
   RGMC_CHECK(comp == 0, "one component");
-  RGMC_CHECK(g.Mesh.NumberOfTriangles() == 1 && g.Mesh.NumberOfPoints() == 3, "one triangle");
-  RGMC_CHECK(g.Ports.empty(), "no ports on one rank");
+  RGMC_CHECK(g.Mesh().NumberOfTriangles() == 1 && g.Mesh().NumberOfPoints() == 3, "one triangle");
+  RGMC_CHECK(g.Ports().empty(), "no ports on one rank");
   // The vertex on the x edge: t = 0.5, at (0.5, 0, 0). Its normal interpolates the negative
   // gradients (1, 1, 1) at (0,0,0) and (1, 0, 0) at (1,0,0) (one-sided at the border).
-  for (std::int64_t p = 0; p < g.Mesh.NumberOfPoints(); ++p)
+  for (std::int64_t p = 0; p < g.Mesh().NumberOfPoints(); ++p)
   {
     int q[3], axis;
-    grid.Decode(g.Mesh.Keys[p], q, axis);
+    grid.Decode(g.Mesh().Keys[p], q, axis);
     RGMC_CHECK(q[0] == 0 && q[1] == 0 && q[2] == 0 && axis >= 0, "vertex on an edge of corner 0");
     double expected[3] = { 0, 0, 0 };
     expected[axis] = 0.5;
     for (int a = 0; a < 3; ++a)
     {
-      RGMC_CHECK(g.Mesh.Points[3 * p + a] == expected[a], "position of vertex on axis " << axis);
+      RGMC_CHECK(g.Mesh().Points[3 * p + a] == expected[a], "position of vertex on axis " << axis);
     }
     double n[3] = { 0.5, 0.5, 0.5 };
     n[axis] = 1.0;
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     for (int a = 0; a < 3; ++a)
     {
-      RGMC_CHECK(std::fabs(g.Mesh.Normals[3 * p + a] - n[a] / len) < 1e-6, "normal on axis " << axis);
+      RGMC_CHECK(
+        std::fabs(g.Mesh().Normals[3 * p + a] - n[a] / len) < 1e-6, "normal on axis " << axis);
     }
   }
 }
@@ -138,32 +139,34 @@ void TwoBlobs()
   vol.At(5, 1, 1) = 1.0f;
   const rgmc::Grid grid(vol.Extent, vol.Extent);
   const rgmc::Ownership own = OwnAll(grid);
-  rgmc::GrowerParams params;
+  rgmc::SurfaceOptions params;
   params.Isovalue = 0.5;
   {
-    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    rgmc::SurfaceKernel<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowFromKey(grid.EdgeKey(4, 1, 1, 0)); // the edge from (4,1,1) to (5,1,1): blob 2
-    RGMC_CHECK(g.GrowFromKey(grid.EdgeKey(5, 1, 1, 1)) == -2, "a second seed on blob 2 finds it grown");
+    RGMC_CHECK(
+      g.GrowFromKey(grid.EdgeKey(5, 1, 1, 1)) == -2, "a second seed on blob 2 finds it grown");
     RGMC_CHECK(g.GrowFromKey(grid.EdgeKey(0, 0, 0, 0)) == -1, "no surface at that key");
     g.Extract();
-    const std::set<Triangle> tris = KeyTriangles(g.Mesh);
-    RGMC_CHECK(tris.size() == 8 && Closed(tris), "seeded growth gives blob 2 only: " << tris.size());
-    for (std::int64_t p = 0; p < g.Mesh.NumberOfPoints(); ++p)
+    const std::set<Triangle> tris = KeyTriangles(g.Mesh());
+    RGMC_CHECK(
+      tris.size() == 8 && Closed(tris), "seeded growth gives blob 2 only: " << tris.size());
+    for (std::int64_t p = 0; p < g.Mesh().NumberOfPoints(); ++p)
     {
-      RGMC_CHECK(g.Mesh.Points[3 * p] > 3.0, "a vertex of blob 1 was extracted");
+      RGMC_CHECK(g.Mesh().Points[3 * p] > 3.0, "a vertex of blob 1 was extracted");
     }
   }
   {
-    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    rgmc::SurfaceKernel<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowAll();
     g.Extract();
     int roots = 0;
-    for (int c = 0; c < static_cast<int>(g.Components.size()); ++c)
+    for (int c = 0; c < g.Components.Size(); ++c)
     {
-      if (g.Root(c) == c)
+      if (g.Components.Root(c) == c)
       {
         ++roots;
-        RGMC_CHECK(g.Components[c].Triangles == 8, "each blob has 8 triangles");
+        RGMC_CHECK(g.Components.TotalsOf(c).Triangles == 8, "each blob has 8 triangles");
       }
     }
     RGMC_CHECK(roots == 2, "two components, not " << roots);
@@ -178,12 +181,12 @@ void SampleEqualsIsovalue()
   vol.At(1, 1, 1) = 0.5f;
   const rgmc::Grid grid(vol.Extent, vol.Extent);
   const rgmc::Ownership own = OwnAll(grid);
-  rgmc::GrowerParams params;
+  rgmc::SurfaceOptions params;
   params.Isovalue = 0.5;
-  rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+  rgmc::SurfaceKernel<std::vector<float>> g(Table(), grid, own, vol.Values, params);
   g.GrowAll();
   g.Extract();
-  RGMC_CHECK(g.Mesh.NumberOfTriangles() == 0, "collapsed triangles must be dropped");
+  RGMC_CHECK(g.Mesh().NumberOfTriangles() == 0, "collapsed triangles must be dropped");
 
   // A blob whose neighbour sample equals the isovalue: the vertices on that sample's edges are
   // the grid point itself, shared by all its edges, and the surface stays closed.
@@ -192,12 +195,12 @@ void SampleEqualsIsovalue()
   pinch.At(2, 1, 1) = 0.5f;
   const rgmc::Grid grid2(pinch.Extent, pinch.Extent);
   const rgmc::Ownership own2 = OwnAll(grid2);
-  rgmc::Grower<std::vector<float>> h(Table(), grid2, own2, pinch.Values, params);
+  rgmc::SurfaceKernel<std::vector<float>> h(Table(), grid2, own2, pinch.Values, params);
   h.GrowAll();
   h.Extract();
-  const std::set<Triangle> tris = KeyTriangles(h.Mesh);
+  const std::set<Triangle> tris = KeyTriangles(h.Mesh());
   int pointKeys = 0;
-  for (std::int64_t key : h.Mesh.Keys)
+  for (std::int64_t key : h.Mesh().Keys)
   {
     pointKeys += grid2.IsPointKey(key);
   }
@@ -215,18 +218,19 @@ void SplitOwnership()
     {
       for (int i = 0; i <= 11; ++i)
       {
-        vol.At(i, j, k) = static_cast<float>(std::sin(0.9 * i) * std::cos(0.7 * j) + 0.3 * std::sin(1.3 * k));
+        vol.At(i, j, k) =
+          static_cast<float>(std::sin(0.9 * i) * std::cos(0.7 * j) + 0.3 * std::sin(1.3 * k));
       }
     }
   }
   const rgmc::Grid grid(vol.Extent, vol.Extent);
-  rgmc::GrowerParams params;
+  rgmc::SurfaceOptions params;
   params.Isovalue = 0.2;
   const rgmc::Ownership one = OwnAll(grid);
-  rgmc::Grower<std::vector<float>> whole(Table(), grid, one, vol.Values, params);
+  rgmc::SurfaceKernel<std::vector<float>> whole(Table(), grid, one, vol.Values, params);
   whole.GrowAll();
   whole.Extract();
-  const std::set<Triangle> expected = KeyTriangles(whole.Mesh);
+  const std::set<Triangle> expected = KeyTriangles(whole.Mesh());
 
   std::vector<rgmc::CellBox> boxes(2, grid.WholeCells());
   boxes[0].Hi[0] = 4;
@@ -236,14 +240,14 @@ void SplitOwnership()
   for (int r = 0; r < 2; ++r)
   {
     const rgmc::Ownership own(boxes, r);
-    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    rgmc::SurfaceKernel<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowAll();
     g.Extract();
-    for (const Triangle& t : KeyTriangles(g.Mesh))
+    for (const Triangle& t : KeyTriangles(g.Mesh()))
     {
       RGMC_CHECK(united.insert(t).second, "a triangle was extracted by both owners");
     }
-    for (const rgmc::Port& p : g.Ports)
+    for (const rgmc::Port& p : g.Ports())
     {
       int q[3], axis;
       grid.Decode(p.Key, q, axis);
@@ -251,8 +255,8 @@ void SplitOwnership()
       portSides[p.Key] |= 1 << r;
     }
   }
-  RGMC_CHECK(united == expected, "the owners' union differs from the whole: " << united.size()
-                                                                             << " vs " << expected.size());
+  RGMC_CHECK(united == expected,
+    "the owners' union differs from the whole: " << united.size() << " vs " << expected.size());
   for (const auto& p : portSides)
   {
     RGMC_CHECK(p.second == 3, "port " << p.first << " seen by one owner only");
@@ -276,28 +280,29 @@ void CostFollowsSurface()
       {
         for (int i = 0; i < size; ++i)
         {
-          const double d = std::sqrt((i - 10.3) * (i - 10.3) + (j - 10.7) * (j - 10.7) +
-            (k - 10.1) * (k - 10.1));
+          const double d =
+            std::sqrt((i - 10.3) * (i - 10.3) + (j - 10.7) * (j - 10.7) + (k - 10.1) * (k - 10.1));
           vol.At(i, j, k) = static_cast<float>(6.0 - d);
         }
       }
     }
     const rgmc::Grid grid(vol.Extent, vol.Extent);
     const rgmc::Ownership own = OwnAll(grid);
-    rgmc::GrowerParams params;
+    rgmc::SurfaceOptions params;
     Counted counted{ &vol.Values };
-    rgmc::Grower<Counted> g(Table(), grid, own, counted, params);
+    rgmc::SurfaceKernel<Counted> g(Table(), grid, own, counted, params);
     const double seed[3] = { 16.5, 10.5, 10.5 };
     const rgmc::SeedHit hit = g.NearestVertex(seed, seed, 10.0, 1.0);
     RGMC_CHECK(hit.Found, "the sphere is within the radius");
     g.GrowFromKey(hit.Key);
     g.Extract();
     reads[n] = counted.Reads;
-    triangles[n] = static_cast<std::size_t>(g.Mesh.NumberOfTriangles());
-    RGMC_CHECK(Closed(KeyTriangles(g.Mesh)), "the sphere is closed");
+    triangles[n] = static_cast<std::size_t>(g.Mesh().NumberOfTriangles());
+    RGMC_CHECK(Closed(KeyTriangles(g.Mesh())), "the sphere is closed");
   }
   RGMC_CHECK(triangles[0] == triangles[1] && triangles[0] > 0, "same sphere, same triangles");
-  RGMC_CHECK(reads[0] == reads[1], "reads grew with the volume: " << reads[0] << " vs " << reads[1]);
+  RGMC_CHECK(
+    reads[0] == reads[1], "reads grew with the volume: " << reads[0] << " vs " << reads[1]);
   // 24^3 has 12167 cubes; the growth must stay well below one read per sample of the volume.
   RGMC_CHECK(reads[1] < 96LL * 96 * 96 / 20, "reads " << reads[1] << " look like a full scan");
 }
@@ -308,7 +313,8 @@ void CostFollowsSurface()
 void TraversalIsComplete()
 {
   std::uint64_t state = 88172645463325252ull;
-  auto next = [&state]() {
+  auto next = [&state]()
+  {
     state ^= state << 13;
     state ^= state >> 7;
     state ^= state << 17;
@@ -326,13 +332,13 @@ void TraversalIsComplete()
     }
     const rgmc::Grid grid(vol.Extent, vol.Extent);
     const rgmc::Ownership own = OwnAll(grid);
-    rgmc::GrowerParams params;
+    rgmc::SurfaceOptions params;
     params.Isovalue = 1.0;
-    rgmc::Grower<std::vector<float>> g(Table(), grid, own, vol.Values, params);
+    rgmc::SurfaceKernel<std::vector<float>> g(Table(), grid, own, vol.Values, params);
     g.GrowAll();
     g.Extract();
     joins += g.Joins();
-    triangles += g.Mesh.NumberOfTriangles();
+    triangles += g.Mesh().NumberOfTriangles();
   }
   RGMC_CHECK(triangles > 0, "the volumes have surfaces");
   RGMC_CHECK(joins == 0, "growth missed " << joins << " adjacencies that a later component met");
