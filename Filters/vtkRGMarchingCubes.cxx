@@ -31,6 +31,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTypeInt32Array.h"
@@ -40,6 +41,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -965,6 +967,13 @@ void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
   {
     this->UpdateProgress(0.1 + 0.7 * fraction);
     return this->CheckAbort();
+  };
+  // Threads within the rank: vtkSMPTools, so ParaView's and VTK's settings govern them
+  // (VTK_SMP_BACKEND_IN_USE, VTK_SMP_MAX_THREADS). Each index is a large task (a tile, a chunk).
+  options.ParallelFor = [](std::int64_t count, const std::function<void(std::int64_t, std::int64_t)>& body)
+  {
+    vtkSMPTools::For(vtkIdType(0), static_cast<vtkIdType>(count), vtkIdType(1),
+      [&body](vtkIdType begin, vtkIdType end) { body(begin, end); });
   };
   MakeKernel make{ run.grid.get(), run.own.get(), &options, nullptr };
   if (run.scalars)

@@ -25,6 +25,27 @@ public:
   Buffer() = default;
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
+  Buffer(Buffer&& other) noexcept
+    : Data(other.Data)
+    , Size(other.Size)
+    , Capacity(other.Capacity)
+  {
+    other.Data = nullptr;
+    other.Size = other.Capacity = 0;
+  }
+  Buffer& operator=(Buffer&& other) noexcept
+  {
+    if (this != &other)
+    {
+      std::free(this->Data);
+      this->Data = other.Data;
+      this->Size = other.Size;
+      this->Capacity = other.Capacity;
+      other.Data = nullptr;
+      other.Size = other.Capacity = 0;
+    }
+    return *this;
+  }
   ~Buffer() { std::free(this->Data); }
 
   std::size_t size() const { return this->Size; }
@@ -70,6 +91,13 @@ public:
     }
     std::memcpy(this->Data + this->Size, values, n * sizeof(T));
     this->Size += n;
+  }
+
+  /// Holds n values, those beyond the old size left unset (to be written next).
+  void resize_for_overwrite(std::size_t n)
+  {
+    this->reserve(n);
+    this->Size = n;
   }
 
   /// Shrinks to the first n values (n <= size()).

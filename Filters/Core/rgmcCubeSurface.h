@@ -16,10 +16,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -39,9 +42,15 @@ struct SurfaceOptions
   /// Maps an index-space gradient to a world-space normal before normalizing:
   /// det(direction) * direction * diag(1 / spacing), as vtkImageTransform does.
   double NormalToWorld[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
-  /// Called now and then with the fraction done (growth fills the first half, extraction the
-  /// second; never decreasing); returns true to abort.
+  /// Called now and then, from the calling thread only, with the fraction done (growth fills
+  /// the first half, extraction the second; never decreasing); returns true to abort.
   std::function<bool(double)> Progress;
+  /// Runs body(begin, end) over ranges that cover [0, count) exactly once, possibly on several
+  /// threads at once (the VTK layer passes vtkSMPTools::For). Empty: one range on this thread.
+  /// The results never depend on how the ranges are cut or run.
+  std::function<void(std::int64_t count,
+    const std::function<void(std::int64_t begin, std::int64_t end)>& body)>
+    ParallelFor;
 };
 
 /// The samples at the 8 corners of a cube (VTK's corner order) and its case.
@@ -449,20 +458,65 @@ public:
   // ---- state shared by the passes ------------------------------------------------------------
 
   /// Empty unless a sample was not a number (the message names the grid point).
-  const std::string& Error() const { return this->ErrorText; }
+  std::string Error() const
+  {
+    std::lock_guard<std::mutex> lock(this->ErrorMutex);
+    return this->ErrorText;
+  }
   bool Aborted() const { return this->AbortFlag; }
-  bool Stopped() const { return this->AbortFlag || !this->ErrorText.empty(); }
+  /// Whether the work should stop: aborted, a NaN met, or a task of Parallel failed.
+  bool Stopped() const { return this->AbortFlag || this->Failed || this->Interrupted; }
   /// True when a gradient needed a sample beyond this piece that lies inside the volume (the
   /// input lacked its ghost layer); such normals are one-sided.
   bool MissingGhosts() const { return this->GhostsMissing; }
 
-  /// Reports progress (never backwards) and notes an abort.
+  /// Reports progress (never backwards) and notes an abort. From the calling thread only.
   void Report(double fraction)
   {
     this->Reported = std::max(this->Reported, fraction);
     if (this->Options.Progress && this->Options.Progress(this->Reported))
     {
       this->AbortFlag = true;
+    }
+  }
+
+  /// Runs task(i) for every i in [0, count), through Options.ParallelFor. An exception thrown
+  /// by a task stops the others and is thrown again here (the first one caught).
+  template <typename Task>
+  void Parallel(std::int64_t count, Task&& task)
+  {
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    auto range = [&](std::int64_t begin, std::int64_t end)
+    {
+      for (std::int64_t i = begin; i < end && !this->Stopped(); ++i)
+      {
+        try
+        {
+          task(i);
+        }
+        catch (...)
+        {
+          std::lock_guard<std::mutex> lock(failureMutex);
+          if (!failure)
+          {
+            failure = std::current_exception();
+          }
+          this->Interrupted = true;
+        }
+      }
+    };
+    if (this->Options.ParallelFor && count > 1)
+    {
+      this->Options.ParallelFor(count, range);
+    }
+    else
+    {
+      range(0, count);
+    }
+    if (failure)
+    {
+      std::rethrow_exception(failure);
     }
   }
 
@@ -598,6 +652,8 @@ public:
 private:
   void Fail(int i, int j, int k)
   {
+    std::lock_guard<std::mutex> lock(this->ErrorMutex);
+    this->Failed = true;
     if (this->ErrorText.empty())
     {
       std::ostringstream msg;
@@ -691,9 +747,12 @@ private:
   int CentralLo[3], CentralHi[3];
   int InnerLo[3], InnerHi[3];
   double Reported = 0.0;
+  mutable std::mutex ErrorMutex;
   std::string ErrorText;
-  bool AbortFlag = false;
-  bool GhostsMissing = false;
+  std::atomic<bool> Failed{ false };
+  std::atomic<bool> AbortFlag{ false };
+  std::atomic<bool> Interrupted{ false };
+  std::atomic<bool> GhostsMissing{ false };
 };
 
 } // namespace rgmc

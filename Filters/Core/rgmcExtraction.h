@@ -10,8 +10,10 @@
 #include "rgmcCubeSurface.h"
 #include "rgmcKeyMap.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <stdexcept>
 #include <vector>
 
@@ -128,13 +130,15 @@ public:
   LocalMesh Mesh;
   std::vector<Port> Ports;
 
-  /// How often extraction met a vertex that another component had created. On a single owner
-  /// growth follows every adjacency, so this stays 0; across owners it joins components that
-  /// meet through cubes of another rank.
+  /// How often extraction joined two components through a vertex both use: components of one
+  /// surface that growth labelled apart (per tile in the full scan, and across owners, where
+  /// components meet through cubes of another rank).
   std::int64_t Joins() const { return this->JoinCount; }
 
   /// Makes the triangles of `nodes` (reordered by slab); fills Mesh, Ports and the components'
-  /// triangle counts and smallest keys.
+  /// triangle counts and smallest keys. Slabs are cut into chunks of ChunkSlabs, extracted at
+  /// once (on threads) and joined in chunk order, so that the result does not depend on the
+  /// number of threads.
   void Extract(std::vector<SurfaceNode>& nodes)
   {
     if (nodes.empty() || this->Volume.Stopped())
@@ -160,20 +164,19 @@ public:
     }
     const int numSlabs = box.Hi[2] - box.Lo[2] + 1;
 
-    // Nodes by slab (a counting sort on k).
+    // Nodes by slab (a counting sort on k, keeping growth's order within a slab).
     std::vector<std::int64_t> start(static_cast<std::size_t>(numSlabs) + 1, 0);
-    std::int64_t triangles = 0;
+    std::vector<std::int64_t> slabTriangles(static_cast<std::size_t>(numSlabs), 0);
     for (const SurfaceNode& n : nodes)
     {
       ++start[n.K - box.Lo[2] + 1];
-      triangles += this->Volume.Table[n.Case].NumTriangles;
+      slabTriangles[n.K - box.Lo[2]] += this->Volume.Table[n.Case].NumTriangles;
     }
     for (int s = 0; s < numSlabs; ++s)
     {
       start[s + 1] += start[s];
     }
     {
-      // Reorder the nodes by slab, so that extraction reads them in sequence.
       std::vector<std::int64_t> next(start.begin(), start.end() - 1);
       std::vector<SurfaceNode> sorted(nodes.size());
       for (const SurfaceNode& n : nodes)
@@ -182,9 +185,100 @@ public:
       }
       nodes.swap(sorted);
     }
+    this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
+    this->PlaneSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
+
+    const int numChunks = (numSlabs + ChunkSlabs - 1) / ChunkSlabs;
+    std::vector<Chunk> chunks(static_cast<std::size_t>(numChunks));
+    for (int c = 0; c < numChunks && !this->Volume.Stopped(); c += ChunksPerReport)
+    {
+      const int batch = std::min(ChunksPerReport, numChunks - c);
+      this->Volume.Parallel(batch,
+        [&](std::int64_t n)
+        {
+          const int chunk = c + static_cast<int>(n);
+          const int first = chunk * ChunkSlabs, last = std::min(numSlabs, first + ChunkSlabs);
+          std::int64_t triangles = 0;
+          for (int s = first; s < last; ++s)
+          {
+            triangles += slabTriangles[s];
+          }
+          this->ExtractChunk(nodes, start, first, last, triangles, chunks[chunk]);
+        });
+      this->Volume.Report(0.5 + 0.45 * (c + batch) / numChunks);
+    }
+    if (this->Volume.Stopped())
+    {
+      return;
+    }
+    this->JoinChunks(chunks);
+    this->Volume.Report(1.0);
+  }
+
+private:
+  static constexpr int ChunkSlabs = 16;     // slabs of cubes per chunk (not per thread)
+  static constexpr int ChunksPerReport = 8; // chunks between progress reports
+
+  /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
+  /// reset cheaply).
+  struct EdgeLayer
+  {
+    ZeroedArray<std::int32_t> Ids;
+    std::vector<std::int32_t> Touched;
+    void Reset()
+    {
+      for (std::int32_t t : this->Touched)
+      {
+        this->Ids[t] = 0;
+      }
+      this->Touched.clear();
+    }
+  };
+
+  /// A vertex that other ranks may also have, by its id in a chunk.
+  struct ChunkPort
+  {
+    std::int32_t Vertex;
+    int Component;
+  };
+
+  /// What one chunk of slabs produced, with chunk-local vertex ids.
+  struct Chunk
+  {
+    LocalMesh Mesh;
+    std::vector<ChunkPort> Ports;
+    /// Pairs of components that share a vertex in this chunk (or with the chunk below).
+    std::vector<std::pair<int, int>> Joins;
+    /// Vertices on the chunk's lowest plane of grid points and on the plane above its last
+    /// slab (x and y edges, grid points): the ones the neighbouring chunks may have too.
+    std::vector<std::int32_t> BottomPlane, TopPlane;
+    int LowK = 0, TopK = 0;
+    /// Per vertex: its id in the joined mesh.
+    std::vector<std::int32_t> FinalId;
+  };
+
+  /// The state of one chunk's extraction (one task).
+  struct ChunkWork
+  {
+    Chunk* Out;
+    EdgeLayer Layers[5];
+    EdgeLayer* SlabLayers[2][2] = { { nullptr, nullptr }, { nullptr, nullptr } };
+    EdgeLayer* VerticalLayer = nullptr;
+    int SlabK = 0;
+    KeyMap PointVertices{ 64 };
+  };
+
+  void ExtractChunk(const std::vector<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
+    int first, int last, std::int64_t triangles, Chunk& chunk)
+  {
+    const CellBox& box = this->NodeBox;
+    ChunkWork work;
+    work.Out = &chunk;
+    chunk.LowK = box.Lo[2] + first;
+    chunk.TopK = box.Lo[2] + last; // the plane above the last slab
     // A node emits at most its case's triangles; a closed surface has about half as many
     // vertices as triangles.
-    LocalMesh& m = this->Mesh;
+    LocalMesh& m = chunk.Mesh;
     const std::size_t vertices = static_cast<std::size_t>(triangles / 2 + 64);
     m.Triangles.reserve(static_cast<std::size_t>(3 * triangles));
     m.TriangleComponent.reserve(static_cast<std::size_t>(triangles));
@@ -202,38 +296,32 @@ public:
     {
       m.Normals.reserve(3 * vertices);
     }
-
     // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,
     // z edges inside it. The top plane becomes the next slab's bottom.
-    this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
-    const std::size_t planeSize =
-      static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
-    for (auto& layer : this->Layers)
+    for (auto& layer : work.Layers)
     {
-      layer.Ids.Allocate(planeSize);
-      layer.Touched.clear();
+      layer.Ids.Allocate(this->PlaneSize);
     }
-    EdgeLayer* bottom[2] = { &this->Layers[0], &this->Layers[1] }; // x, y edges at z = k
-    EdgeLayer* top[2] = { &this->Layers[2], &this->Layers[3] };    // x, y edges at z = k + 1
-    EdgeLayer* vertical = &this->Layers[4];                        // z edges
+    EdgeLayer* bottom[2] = { &work.Layers[0], &work.Layers[1] }; // x, y edges at z = k
+    EdgeLayer* top[2] = { &work.Layers[2], &work.Layers[3] };    // x, y edges at z = k + 1
+    EdgeLayer* vertical = &work.Layers[4];                       // z edges
     CubeSamples st;
     CubeSurface surface;
-    for (int s = 0; s < numSlabs && !this->Volume.Stopped(); ++s)
+    for (int s = first; s < last && !this->Volume.Stopped(); ++s)
     {
-      const int k = box.Lo[2] + s;
-      this->SlabLayers[0][0] = bottom[0];
-      this->SlabLayers[0][1] = bottom[1];
-      this->SlabLayers[1][0] = top[0];
-      this->SlabLayers[1][1] = top[1];
-      this->VerticalLayer = vertical;
-      this->SlabK = k;
-      for (std::int64_t n = start[s]; n < start[s + 1] && !this->Volume.Stopped(); ++n)
+      work.SlabLayers[0][0] = bottom[0];
+      work.SlabLayers[0][1] = bottom[1];
+      work.SlabLayers[1][0] = top[0];
+      work.SlabLayers[1][1] = top[1];
+      work.VerticalLayer = vertical;
+      work.SlabK = box.Lo[2] + s;
+      for (std::int64_t n = start[s]; n < start[s + 1]; ++n)
       {
         const SurfaceNode& node = nodes[n];
         if (this->Volume.Evaluate(node.I, node.J, node.K, st))
         {
           this->Volume.Describe(node.I, node.J, node.K, st, surface);
-          this->Emit(node, st, surface);
+          this->Emit(work, node, st, surface);
         }
       }
       for (EdgeLayer* layer : { bottom[0], bottom[1], vertical })
@@ -242,37 +330,19 @@ public:
       }
       std::swap(bottom[0], top[0]);
       std::swap(bottom[1], top[1]);
-      if ((s & 15) == 0)
-      {
-        this->Volume.Report(0.5 + 0.5 * s / numSlabs);
-      }
     }
+    std::sort(chunk.Joins.begin(), chunk.Joins.end());
+    chunk.Joins.erase(std::unique(chunk.Joins.begin(), chunk.Joins.end()), chunk.Joins.end());
   }
 
-private:
-  /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
-  /// reset cheaply).
-  struct EdgeLayer
-  {
-    ZeroedArray<std::int32_t> Ids;
-    std::vector<std::int32_t> Touched;
-    void Reset()
-    {
-      for (std::int32_t t : this->Touched)
-      {
-        this->Ids[t] = 0;
-      }
-      this->Touched.clear();
-    }
-  };
-
-  /// Creates the output point of a vertex: position, normal, component, port check.
-  std::int32_t NewVertex(const SurfaceVertex& v, double sLo, double sHi, int comp)
+  /// Creates the output point of a vertex in a chunk: position, normal, component, port check.
+  std::int32_t NewVertex(ChunkWork& work, const SurfaceVertex& v, double sLo, double sHi, int comp)
   {
     double x[3];
     float normal[3] = { 0, 0, 0 };
     this->Volume.PositionAndNormal(v.Point, v.Axis, sLo, sHi, x, normal);
-    LocalMesh& m = this->Mesh;
+    Chunk& chunk = *work.Out;
+    LocalMesh& m = chunk.Mesh;
     // Vertex ids are 32-bit within a rank (slots hold id + 1).
     if (m.Keys.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() - 1))
     {
@@ -295,26 +365,36 @@ private:
     }
     m.Keys.push_back(v.Key);
     m.VertexComponent.push_back(comp);
-    ComponentSet::Totals& totals = this->Components.TotalsOf(this->Components.Root(comp));
-    totals.MinKey = std::min(totals.MinKey, v.Key);
+    if (v.Axis != 2 && v.Point[2] == chunk.LowK)
+    {
+      chunk.BottomPlane.push_back(id);
+    }
+    if (v.Axis != 2 && v.Point[2] == chunk.TopK)
+    {
+      chunk.TopPlane.push_back(id);
+    }
     if (this->Volume.IsPort(v.Point, v.Axis))
     {
-      this->Ports.push_back(Port{ v.Key, comp });
+      chunk.Ports.push_back(ChunkPort{ id, comp });
     }
     return id;
   }
 
   /// The output point of a vertex met by component `comp`, whose id + 1 is kept in `slot` (0:
-  /// none yet): made on first use; met again by another component, it joins the two.
-  std::int32_t UseVertex(std::int32_t& slot, const SurfaceVertex& v, double sLo, double sHi,
-    int comp, EdgeLayer* layer, std::int32_t index)
+  /// none yet): made on first use; met again by another component, the two are to be joined.
+  std::int32_t UseVertex(ChunkWork& work, std::int32_t& slot, const SurfaceVertex& v, double sLo,
+    double sHi, int comp, EdgeLayer* layer, std::int32_t index)
   {
     if (slot > 0)
     {
-      this->JoinCount += this->Components.Join(this->Mesh.VertexComponent[slot - 1], comp);
+      const int other = work.Out->Mesh.VertexComponent[slot - 1];
+      if (other != comp)
+      {
+        work.Out->Joins.emplace_back(std::min(other, comp), std::max(other, comp));
+      }
       return slot - 1;
     }
-    const std::int32_t id = this->NewVertex(v, sLo, sHi, comp);
+    const std::int32_t id = this->NewVertex(work, v, sLo, sHi, comp);
     slot = id + 1;
     if (layer)
     {
@@ -325,47 +405,211 @@ private:
 
   /// The output point of a vertex of the current node's cube: on an edge (kept in the slab's
   /// edge layers) or on a grid point (kept in a map).
-  std::int32_t Vertex(const SurfaceNode& n, const SurfaceVertex& v, const CubeSamples& st)
+  std::int32_t Vertex(
+    ChunkWork& work, const SurfaceNode& n, const SurfaceVertex& v, const CubeSamples& st)
   {
     if (v.Axis < 0)
     {
       bool inserted;
-      std::int32_t& slot = this->PointVertices.FindOrInsert(v.Key, 0, inserted);
-      return this->UseVertex(slot, v, 0.0, 0.0, n.Component, nullptr, 0);
+      std::int32_t& slot = work.PointVertices.FindOrInsert(v.Key, 0, inserted);
+      return this->UseVertex(work, slot, v, 0.0, 0.0, n.Component, nullptr, 0);
     }
     const CellBox& box = this->NodeBox;
     const std::int32_t index = static_cast<std::int32_t>(
       (v.Point[0] - box.Lo[0]) + this->LayerNx * (v.Point[1] - box.Lo[1]));
     EdgeLayer* layer =
-      v.Axis == 2 ? this->VerticalLayer : this->SlabLayers[v.Point[2] - this->SlabK][v.Axis];
-    return this->UseVertex(layer->Ids[index], v, st.S[EdgeCorners[v.Edge][0]],
+      v.Axis == 2 ? work.VerticalLayer : work.SlabLayers[v.Point[2] - work.SlabK][v.Axis];
+    return this->UseVertex(work, layer->Ids[index], v, st.S[EdgeCorners[v.Edge][0]],
       st.S[EdgeCorners[v.Edge][1]], n.Component, layer, index);
   }
 
   /// Emits the triangles of one node.
-  void Emit(const SurfaceNode& n, const CubeSamples& st, const CubeSurface& surface)
+  void Emit(ChunkWork& work, const SurfaceNode& n, const CubeSamples& st, const CubeSurface& surface)
   {
-    LocalMesh& m = this->Mesh;
+    LocalMesh& m = work.Out->Mesh;
     surface.ForEachTriangle(n.Node,
       [&](const SurfaceVertex* triangle)
       {
-        const std::int32_t ids[3] = { this->Vertex(n, triangle[0], st),
-          this->Vertex(n, triangle[1], st), this->Vertex(n, triangle[2], st) };
+        const std::int32_t ids[3] = { this->Vertex(work, n, triangle[0], st),
+          this->Vertex(work, n, triangle[1], st), this->Vertex(work, n, triangle[2], st) };
         m.Triangles.append(ids, 3);
         m.TriangleComponent.push_back(n.Component);
-        ++this->Components.TotalsOf(this->Components.Root(n.Component)).Triangles;
       });
+  }
+
+  /// Joins the chunks into Mesh and Ports, in chunk order: a vertex on the plane between two
+  /// chunks, made by both, is the lower chunk's; components that share vertices are joined;
+  /// then the components' totals.
+  void JoinChunks(std::vector<Chunk>& chunks)
+  {
+    const std::int64_t numChunks = static_cast<std::int64_t>(chunks.size());
+    // Each chunk's vertices on its bottom plane that the chunk below made too.
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t c)
+      {
+        Chunk& chunk = chunks[c];
+        chunk.FinalId.assign(static_cast<std::size_t>(chunk.Mesh.NumberOfPoints()), 0);
+        if (c == 0 || chunk.BottomPlane.empty())
+        {
+          return;
+        }
+        Chunk& below = chunks[c - 1];
+        std::vector<std::pair<std::int64_t, std::int32_t>> theirs;
+        theirs.reserve(below.TopPlane.size());
+        for (std::int32_t id : below.TopPlane)
+        {
+          theirs.emplace_back(below.Mesh.Keys[id], id);
+        }
+        std::sort(theirs.begin(), theirs.end());
+        for (std::int32_t id : chunk.BottomPlane)
+        {
+          const std::int64_t key = chunk.Mesh.Keys[id];
+          auto it = std::lower_bound(
+            theirs.begin(), theirs.end(), std::make_pair(key, std::int32_t(-1)));
+          if (it != theirs.end() && it->first == key)
+          {
+            chunk.FinalId[id] = -1 - it->second; // the chunk below's vertex
+            const int a = below.Mesh.VertexComponent[it->second];
+            const int b = chunk.Mesh.VertexComponent[id];
+            if (a != b)
+            {
+              chunk.Joins.emplace_back(std::min(a, b), std::max(a, b));
+            }
+          }
+        }
+      });
+    // Joins, in chunk order; vertex ids in the joined mesh.
+    std::int64_t vertices = 0, triangles = 0;
+    std::vector<std::int64_t> vertexBase(static_cast<std::size_t>(numChunks)),
+      triangleBase(static_cast<std::size_t>(numChunks));
+    for (Chunk& chunk : chunks)
+    {
+      for (const auto& pair : chunk.Joins)
+      {
+        this->JoinCount += this->Components.Join(pair.first, pair.second);
+      }
+      chunk.Joins = std::vector<std::pair<int, int>>();
+      const std::size_t c = static_cast<std::size_t>(&chunk - chunks.data());
+      vertexBase[c] = vertices;
+      triangleBase[c] = triangles;
+      for (std::int32_t& id : chunk.FinalId)
+      {
+        if (id == 0)
+        {
+          // Vertex ids are 32-bit within a rank.
+          if (vertices >= std::numeric_limits<std::int32_t>::max() - 1)
+          {
+            throw std::length_error("more than 2147483646 surface vertices in one piece");
+          }
+          id = static_cast<std::int32_t>(vertices++);
+        }
+      }
+      triangles += chunk.Mesh.NumberOfTriangles();
+    }
+    for (std::size_t c = 1; c < chunks.size(); ++c)
+    {
+      for (std::int32_t& id : chunks[c].FinalId)
+      {
+        if (id < 0)
+        {
+          id = chunks[c - 1].FinalId[-1 - id];
+        }
+      }
+    }
+    for (Chunk& chunk : chunks)
+    {
+      for (const ChunkPort& port : chunk.Ports)
+      {
+        const std::int32_t id = port.Vertex;
+        const std::size_t c = static_cast<std::size_t>(&chunk - chunks.data());
+        if (chunk.FinalId[id] >= vertexBase[c]) // not the chunk below's vertex
+        {
+          this->Ports.push_back(Port{ chunk.Mesh.Keys[id], port.Component });
+        }
+      }
+    }
+    // The joined mesh: each chunk's own vertices and all its triangles, copied in place.
+    LocalMesh& m = this->Mesh;
+    const bool doublePoints = this->Volume.Options.DoublePoints;
+    const bool normals = this->Volume.Options.ComputeNormals;
+    const std::size_t nv = static_cast<std::size_t>(vertices);
+    const std::size_t nt = static_cast<std::size_t>(triangles);
+    if (doublePoints)
+    {
+      m.PointsDouble.resize_for_overwrite(3 * nv);
+    }
+    else
+    {
+      m.Points.resize_for_overwrite(3 * nv);
+    }
+    if (normals)
+    {
+      m.Normals.resize_for_overwrite(3 * nv);
+    }
+    m.Keys.resize_for_overwrite(nv);
+    m.VertexComponent.resize_for_overwrite(nv);
+    m.Triangles.resize_for_overwrite(3 * nt);
+    m.TriangleComponent.resize_for_overwrite(nt);
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t c)
+      {
+        Chunk& chunk = chunks[c];
+        const LocalMesh& from = chunk.Mesh;
+        const std::int64_t base = vertexBase[c];
+        for (std::int64_t v = 0; v < from.NumberOfPoints(); ++v)
+        {
+          const std::int64_t to = chunk.FinalId[v];
+          if (to < base)
+          {
+            continue; // the chunk below's vertex
+          }
+          for (int a = 0; a < 3; ++a)
+          {
+            if (doublePoints)
+            {
+              m.PointsDouble[3 * to + a] = from.PointsDouble[3 * v + a];
+            }
+            else
+            {
+              m.Points[3 * to + a] = from.Points[3 * v + a];
+            }
+            if (normals)
+            {
+              m.Normals[3 * to + a] = from.Normals[3 * v + a];
+            }
+          }
+          m.Keys[to] = from.Keys[v];
+          m.VertexComponent[to] = from.VertexComponent[v];
+        }
+        const std::int64_t t0 = triangleBase[c];
+        for (std::int64_t t = 0; t < from.NumberOfTriangles(); ++t)
+        {
+          for (int v = 0; v < 3; ++v)
+          {
+            m.Triangles[3 * (t0 + t) + v] = chunk.FinalId[from.Triangles[3 * t + v]];
+          }
+          m.TriangleComponent[t0 + t] = from.TriangleComponent[t];
+        }
+        chunk = Chunk();
+      });
+    // The components' totals: triangles and smallest key, on their roots.
+    for (std::size_t t = 0; t < nt; ++t)
+    {
+      ++this->Components.TotalsOf(this->Components.Root(m.TriangleComponent[t])).Triangles;
+    }
+    for (std::size_t v = 0; v < nv; ++v)
+    {
+      ComponentSet::Totals& totals =
+        this->Components.TotalsOf(this->Components.Root(m.VertexComponent[v]));
+      totals.MinKey = std::min<std::int64_t>(totals.MinKey, m.Keys[v]);
+    }
   }
 
   SampledVolume<Values>& Volume;
   ComponentSet& Components;
-  EdgeLayer Layers[5];
-  EdgeLayer* SlabLayers[2][2] = { { nullptr, nullptr }, { nullptr, nullptr } };
-  EdgeLayer* VerticalLayer = nullptr;
-  int SlabK = 0;
   std::int64_t LayerNx = 0;
+  std::size_t PlaneSize = 0;
   CellBox NodeBox; // the cubes of the nodes
-  KeyMap PointVertices{ 64 };
   std::int64_t JoinCount = 0;
 };
 

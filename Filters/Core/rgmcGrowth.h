@@ -2,9 +2,18 @@
 // triangle. A breadth-first search over the surface graph from a node visits every other cube
 // that contains one of the node's vertices (3 cubes around an edge, 7 around a grid point), so
 // it reproduces exactly the connectivity of vtkMarchingCubes followed by
-// vtkPolyDataConnectivityFilter while touching only cubes the surface passes through. A bit
-// per owned cube (in pages of 32^3 cubes) says that its nodes were all found; the list of nodes
-// found is also the search's queue.
+// vtkPolyDataConnectivityFilter while touching only cubes the surface passes through.
+//
+// Threads. The owned cubes are cut into tiles of 32^3 (a tile's found-bits are one 4 KiB page).
+// A tile is searched by one task at a time, which alone writes its bits, so tasks never share
+// state. Growth goes in rounds: in a round every tile with work searches, inside itself, from
+// the crossings it received (a vertex and the cube to visit), and hands each step into another
+// tile to that tile as a crossing for the next round - the protocol ranks use between pieces,
+// inside one rank. A tile's work in a round depends only on its crossings, taken in the order
+// of the tiles that sent them, so the nodes found and their order are the same for any number
+// of threads. The full scan (All and Largest modes) searches each tile on its own, crossings
+// dropped: a component that spans tiles gets one label per tile, and extraction joins them
+// through their shared vertices, as it joins components across ranks.
 #ifndef rgmcGrowth_h
 #define rgmcGrowth_h
 
@@ -13,6 +22,7 @@
 #include "rgmcKeyMap.h"
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace rgmc
@@ -27,10 +37,8 @@ public:
     , Components(components)
   {
     const CellBox& box = this->Volume.Owned.Mine();
-    if (!box.Empty())
+    if (!box.Empty() && !this->Volume.Owned.OwnsNothing())
     {
-      // Visited bits in tiles of 32^3 cubes (4 KiB, one page), each tile in words of 4^3 cubes:
-      // a small surface touches a few pages, whatever the size of the volume.
       std::int64_t tiles = 1;
       for (int a = 0; a < 3; ++a)
       {
@@ -38,10 +46,11 @@ public:
         tiles *= this->Tiles[a];
       }
       this->Visited.Allocate(static_cast<std::size_t>(tiles * TileWords));
+      this->Work.resize(static_cast<std::size_t>(tiles));
     }
   }
 
-  /// The nodes found, in the order found.
+  /// The nodes found: by round, then by tile, then in the order each tile found them.
   std::vector<SurfaceNode>& Nodes() { return this->Found; }
 
   /// Grows, as a new seeded component, the component that contains the vertex `key`, from the
@@ -50,28 +59,60 @@ public:
   /// grown before GrowBoundary).
   int GrowFromKey(std::int64_t key)
   {
-    const int comp = this->Components.Add(true);
-    const std::size_t before = this->Found.size();
     int p[3], axis;
     this->Volume.GridOf.Decode(key, p, axis);
     bool seen = false;
-    this->VisitAround(key, p, axis, nullptr, comp, &seen);
-    if (this->Found.size() == before)
-    {
-      this->Components.RemoveLast();
-      return seen ? -2 : -1;
-    }
-    this->ExpandFrom(before);
-    return comp;
+    const int comp = this->GrowFrom(key, p, axis, true, &seen);
+    return comp >= 0 ? comp : (seen ? -2 : -1);
   }
 
   /// Finds every component that has a node in an owned cube (a full scan: the "All" and
-  /// "Largest" modes).
+  /// "Largest" modes). Each tile is scanned on its own; components are labelled per tile.
   void GrowAll()
   {
-    if (!this->Volume.Owned.OwnsNothing())
+    if (this->Work.empty())
     {
-      this->Scan(this->Volume.Owned.Mine(), true);
+      return;
+    }
+    const std::int64_t numTiles = static_cast<std::int64_t>(this->Work.size());
+    std::vector<int> tileComponents(static_cast<std::size_t>(numTiles), 0);
+    // Tiles in slabs of tiles along z, for the progress reported between them.
+    const std::int64_t perSlab = this->Tiles[0] * this->Tiles[1];
+    for (std::int64_t z = 0; z < this->Tiles[2] && !this->Volume.Stopped(); ++z)
+    {
+      this->Volume.Parallel(perSlab,
+        [&](std::int64_t n)
+        {
+          const std::int64_t tile = z * perSlab + n;
+          tileComponents[tile] = this->ScanTile(tile);
+        });
+      this->Volume.Report(0.5 * (z + 1) / this->Tiles[2]);
+    }
+    if (this->Volume.Stopped())
+    {
+      return;
+    }
+    // Tile-local component labels become this rank's: tile by tile, in tile order.
+    std::size_t total = 0;
+    for (TileWork& w : this->Work)
+    {
+      total += w.Queue.size();
+    }
+    this->Found.reserve(this->Found.size() + total);
+    for (std::int64_t tile = 0; tile < numTiles; ++tile)
+    {
+      const int first = this->Components.Size();
+      for (int c = 0; c < tileComponents[tile]; ++c)
+      {
+        this->Components.Add(false);
+      }
+      TileWork& w = this->Work[tile];
+      for (SurfaceNode n : w.Queue)
+      {
+        n.Component += first;
+        this->Found.push_back(n);
+      }
+      w.Queue = std::vector<SurfaceNode>();
     }
   }
 
@@ -83,7 +124,7 @@ public:
   void GrowBoundary()
   {
     const Ownership& own = this->Volume.Owned;
-    if (own.OwnsNothing())
+    if (this->Work.empty())
     {
       return;
     }
@@ -103,44 +144,76 @@ public:
     for (const CellBox& lower : own.Overlaps())
     {
       // Ownership with holes (a reader that ignored piece requests): every cube near them.
-      this->Scan(lower.Grown(1).Intersect(box), false);
+      this->ScanRegion(lower.Grown(1).Intersect(box));
     }
   }
 
 private:
-  /// The bit of an owned cube: tile (32^3 cubes), then word (4^3 cubes) in the tile, then cube.
+  /// A step of the search into a tile: visit cube (I, J, K) for the vertex Key, on the cube's
+  /// edge Edge (-1 for a grid-point key), for component Component.
+  struct Crossing
+  {
+    std::int64_t Key;
+    std::int32_t I, J, K;
+    std::int32_t Component;
+    std::int8_t Edge;
+  };
+
+  /// A tile's search state: nodes found in the current round (the queue), crossings received
+  /// for the next round and sent to other tiles in this one, and which nodes of its cubes of
+  /// several nodes were found.
+  struct TileWork
+  {
+    std::vector<SurfaceNode> Queue;
+    std::vector<Crossing> Inbox;
+    std::vector<Crossing> Outbox;
+    std::unique_ptr<KeyMap> FoundNodesOfCube;
+  };
+
+  static constexpr int TileCubes = 32;  // cubes along each axis of a tile
+  static constexpr int TileWords = 512; // 64-bit words of found-bits in a tile
+
+  std::int64_t TileOf(int i, int j, int k) const
+  {
+    const CellBox& b = this->Volume.Owned.Mine();
+    return ((i - b.Lo[0]) >> 5) +
+      this->Tiles[0] * (((j - b.Lo[1]) >> 5) + std::int64_t(this->Tiles[1]) * ((k - b.Lo[2]) >> 5));
+  }
+
+  /// The found-bit of an owned cube: tile, then word (4^3 cubes) in the tile, then cube.
   std::int64_t CubeBit(int i, int j, int k) const
   {
     const CellBox& b = this->Volume.Owned.Mine();
     const int x = i - b.Lo[0], y = j - b.Lo[1], z = k - b.Lo[2];
-    const std::int64_t tile =
-      (x >> 5) + this->Tiles[0] * ((y >> 5) + std::int64_t(this->Tiles[1]) * (z >> 5));
     const int word = ((x >> 2) & 7) + 8 * (((y >> 2) & 7) + 8 * ((z >> 2) & 7));
     const int bit = (x & 3) + 4 * ((y & 3) + 4 * (z & 3));
-    return (tile * TileWords + word) * 64 + bit;
+    return (this->TileOf(i, j, k) * TileWords + word) * 64 + bit;
   }
 
   bool AllFound(std::int64_t bit) const { return (this->Visited[bit >> 6] >> (bit & 63)) & 1u; }
-  void SetAllFound(std::int64_t bit) { this->Visited[bit >> 6] |= std::uint64_t(1) << (bit & 63); }
+  void SetAllFound(std::int64_t bit)
+  {
+    this->Visited[bit >> 6] |= std::uint64_t(1) << (bit & 63);
+  }
 
-  bool NodeFound(std::int64_t bit, int node, int numNodes) const
+  bool NodeFound(TileWork& w, std::int64_t bit, int node, int numNodes) const
   {
     if (this->AllFound(bit))
     {
       return true;
     }
-    if (numNodes == 1)
+    if (numNodes == 1 || !w.FoundNodesOfCube)
     {
       return false;
     }
-    const std::int32_t* mask = this->FoundNodesOfCube.Find(bit);
+    const std::int32_t* mask = w.FoundNodesOfCube->Find(bit);
     return mask && ((*mask >> node) & 1);
   }
 
-  /// Records node `node` of cube (i, j, k) found and appends it to the list (the queue). Cubes
-  /// with one node use only the bit per cube; cubes with several remember which were found.
-  void Record(
-    int i, int j, int k, std::int64_t bit, const CubeSamples& st, int node, int numNodes, int comp)
+  /// Records node `node` of cube (i, j, k) found and queues it in its tile. Cubes with one node
+  /// use only the bit per cube; cubes with several remember which were found.
+  void Record(TileWork& w, int i, int j, int k, std::int64_t bit, const CubeSamples& st,
+    int node, int numNodes, int comp)
   {
     if (numNodes == 1)
     {
@@ -148,8 +221,12 @@ private:
     }
     else
     {
+      if (!w.FoundNodesOfCube)
+      {
+        w.FoundNodesOfCube.reset(new KeyMap(64));
+      }
       bool inserted;
-      std::int32_t& mask = this->FoundNodesOfCube.FindOrInsert(bit, 0, inserted);
+      std::int32_t& mask = w.FoundNodesOfCube->FindOrInsert(bit, 0, inserted);
       if ((mask >> node) & 1)
       {
         return;
@@ -160,18 +237,14 @@ private:
         this->SetAllFound(bit);
       }
     }
-    this->Found.push_back(SurfaceNode{ i, j, k, comp, static_cast<std::uint8_t>(st.Case),
+    w.Queue.push_back(SurfaceNode{ i, j, k, comp, static_cast<std::uint8_t>(st.Case),
       static_cast<std::uint8_t>(node), st.Degenerate });
   }
 
-  /// Records the nodes of cube (i, j, k) that use vertex `key` (on the cube's edge `edge`; -1
-  /// for a grid-point key). `seen` is set when such a node was found before.
-  void Visit(int i, int j, int k, std::int64_t key, int edge, int comp, bool* seen)
+  /// Records the nodes of owned cube (i, j, k) that use vertex `key` (on the cube's edge
+  /// `edge`; -1 for a grid-point key). `seen` is set when such a node was found before.
+  void Visit(TileWork& w, int i, int j, int k, std::int64_t key, int edge, int comp, bool* seen)
   {
-    if (!this->Volume.Owned.Owns(i, j, k)) // owned cubes lie inside the volume
-    {
-      return;
-    }
     const std::int64_t bit = this->CubeBit(i, j, k);
     if (this->AllFound(bit) && !seen)
     {
@@ -190,7 +263,7 @@ private:
     {
       const int node = __builtin_ctz(nodes);
       nodes &= nodes - 1;
-      if (this->NodeFound(bit, node, numNodes))
+      if (this->NodeFound(w, bit, node, numNodes))
       {
         if (seen)
         {
@@ -198,29 +271,16 @@ private:
         }
         continue;
       }
-      this->Record(i, j, k, bit, st, node, numNodes, comp);
+      this->Record(w, i, j, k, bit, st, node, numNodes, comp);
     }
   }
 
-  /// Visits every cube that contains the vertex `key` (at grid point p; `axis` < 0 for a
-  /// grid-point vertex), except `from`.
-  void VisitAround(
-    std::int64_t key, const int p[3], int axis, const int* from, int comp, bool* seen = nullptr)
+  /// Visits the neighbours of one node of tile `tile`: every other cube that has one of its
+  /// vertices. Cubes of the tile are visited now; owned cubes of other tiles get a crossing
+  /// (unless `keepInTile`: then they are left to their own tile's scan).
+  void Expand(std::int64_t tile, const SurfaceNode& n, bool keepInTile)
   {
-    ForCubesAround(p, axis,
-      [&](int i, int j, int k, int edge)
-      {
-        if (!from || i != from[0] || j != from[1] || k != from[2])
-        {
-          this->Visit(i, j, k, key, edge, comp, seen);
-        }
-      });
-  }
-
-  /// Visits the neighbours of one node: every other cube that has one of its vertices.
-  void Expand(const SurfaceNode& n)
-  {
-    const int from[3] = { n.I, n.J, n.K };
+    TileWork& w = this->Work[tile];
     CubeSamples st;
     if (n.Degenerate && !this->Volume.Evaluate(n.I, n.J, n.K, st))
     {
@@ -231,39 +291,131 @@ private:
     st.Degenerate = n.Degenerate;
     CubeSurface surface;
     this->Volume.Describe(n.I, n.J, n.K, st, surface);
+    const Ownership& own = this->Volume.Owned;
     surface.ForEachVertex(n.Node,
       [&](const SurfaceVertex& v)
-      { this->VisitAround(v.Key, v.Point, v.Axis, from, n.Component); });
+      {
+        ForCubesAround(v.Point, v.Axis,
+          [&](int i, int j, int k, int edge)
+          {
+            if ((i == n.I && j == n.J && k == n.K) || !own.Owns(i, j, k))
+            {
+              return; // owned cubes lie inside the volume
+            }
+            const std::int64_t to = this->TileOf(i, j, k);
+            if (to == tile)
+            {
+              this->Visit(w, i, j, k, v.Key, edge, n.Component, nullptr);
+            }
+            else if (!keepInTile)
+            {
+              w.Outbox.push_back(Crossing{ v.Key, i, j, k, n.Component,
+                static_cast<std::int8_t>(edge) });
+            }
+          });
+      });
   }
 
-  /// Expands the listed nodes from `head` on, until none is left.
-  void ExpandFrom(std::size_t head)
+  /// Expands tile `tile`'s queue from `head` on, inside the tile.
+  void ExpandQueue(std::int64_t tile, std::size_t head, bool keepInTile)
   {
-    for (; head < this->Found.size() && !this->Volume.Stopped(); ++head)
+    TileWork& w = this->Work[tile];
+    for (; head < w.Queue.size() && !this->Volume.Stopped(); ++head)
     {
-      const SurfaceNode n = this->Found[head];
-      this->Expand(n);
-      if ((++this->NodesExpanded & 0x3fff) == 0)
-      {
-        // The surface's size is unknown while it grows: an estimate that approaches 1.
-        const double done = static_cast<double>(this->NodesExpanded);
-        this->Volume.Report(0.5 * done / (done + 4.0 * (this->Found.size() - head) + (1 << 20)));
-      }
+      const SurfaceNode n = w.Queue[head];
+      this->Expand(tile, n, keepInTile);
     }
   }
 
-  /// Grows a new component from the nodes that use vertex `key`, unless they were found.
-  void GrowUnseeded(std::int64_t key, const int p[3], int axis)
+  /// Grows, as a new component, from the nodes that use vertex `key` (at grid point p; axis < 0
+  /// for a grid-point key) unless they were all found; rounds until no tile has work. Returns
+  /// the component, or -1 when nothing new was found (`seen` says whether it was found before).
+  int GrowFrom(std::int64_t key, const int p[3], int axis, bool seeded, bool* seen)
   {
-    const std::size_t head = this->Found.size();
-    const int comp = this->Components.Add(false);
-    this->VisitAround(key, p, axis, nullptr, comp);
-    if (this->Found.size() == head)
+    if (this->Work.empty())
+    {
+      return -1;
+    }
+    const int comp = this->Components.Add(seeded);
+    std::vector<std::int64_t> active;
+    bool any = false;
+    ForCubesAround(p, axis,
+      [&](int i, int j, int k, int edge)
+      {
+        if (!this->Volume.Owned.Owns(i, j, k))
+        {
+          return;
+        }
+        const std::int64_t tile = this->TileOf(i, j, k);
+        TileWork& w = this->Work[tile];
+        const std::size_t before = w.Queue.size();
+        this->Visit(w, i, j, k, key, edge, comp, seen);
+        if (w.Queue.size() > before)
+        {
+          any = true;
+          if (std::find(active.begin(), active.end(), tile) == active.end())
+          {
+            active.push_back(tile);
+          }
+        }
+      });
+    if (!any)
     {
       this->Components.RemoveLast();
-      return;
+      return -1;
     }
-    this->ExpandFrom(head);
+    std::sort(active.begin(), active.end());
+    this->Rounds(active);
+    return comp;
+  }
+
+  /// Searches the active tiles (sorted; their queues hold the nodes found so far) in rounds
+  /// until no crossing is left, appending the nodes found to Found.
+  void Rounds(std::vector<std::int64_t> active)
+  {
+    while (!active.empty() && !this->Volume.Stopped())
+    {
+      this->Volume.Parallel(static_cast<std::int64_t>(active.size()),
+        [&](std::int64_t n)
+        {
+          const std::int64_t tile = active[n];
+          TileWork& w = this->Work[tile];
+          for (const Crossing& c : w.Inbox)
+          {
+            this->Visit(w, c.I, c.J, c.K, c.Key, c.Edge, c.Component, nullptr);
+          }
+          w.Inbox = std::vector<Crossing>();
+          this->ExpandQueue(tile, 0, false);
+        });
+      if (this->Volume.Stopped())
+      {
+        return;
+      }
+      // The round's nodes, tile by tile; the crossings, in the order of their senders.
+      std::vector<std::int64_t> next;
+      for (const std::int64_t tile : active)
+      {
+        TileWork& w = this->Work[tile];
+        this->Found.insert(this->Found.end(), w.Queue.begin(), w.Queue.end());
+        this->NodesExpanded += static_cast<std::int64_t>(w.Queue.size());
+        w.Queue.clear();
+        for (const Crossing& c : w.Outbox)
+        {
+          const std::int64_t to = this->TileOf(c.I, c.J, c.K);
+          if (this->Work[to].Inbox.empty())
+          {
+            next.push_back(to);
+          }
+          this->Work[to].Inbox.push_back(c);
+        }
+        w.Outbox = std::vector<Crossing>();
+      }
+      std::sort(next.begin(), next.end());
+      active.swap(next);
+      // The surface's size is unknown while it grows: an estimate that approaches 1.
+      const double done = static_cast<double>(this->NodesExpanded);
+      this->Volume.Report(0.5 * done / (done + (1 << 20)));
+    }
   }
 
   /// Grows from every vertex on the plane of grid points p[axis] = `plane` of this rank's box.
@@ -283,7 +435,7 @@ private:
         const double s = volume.Read(p[0], p[1], p[2]);
         if (s == c)
         {
-          this->GrowUnseeded(grid.PointKey(p[0], p[1], p[2]), p, -1);
+          this->GrowFrom(grid.PointKey(p[0], p[1], p[2]), p, -1, false, nullptr);
         }
         for (const int along : { u, v })
         {
@@ -296,25 +448,80 @@ private:
           const double t = volume.Read(q[0], q[1], q[2]);
           if ((s >= c) != (t >= c) && s != c && t != c)
           {
-            this->GrowUnseeded(grid.EdgeKey(p[0], p[1], p[2], along), p, along);
+            this->GrowFrom(grid.EdgeKey(p[0], p[1], p[2], along), p, along, false, nullptr);
           }
         }
       }
     }
   }
 
-  /// Starts a new component from every unfound node of the owned cubes in `region`.
-  void Scan(const CellBox& region, bool reportProgress)
+  /// The cubes of tile `tile` (within the owned box), in k, j, i order.
+  CellBox TileBox(std::int64_t tile) const
+  {
+    const CellBox& b = this->Volume.Owned.Mine();
+    const std::int64_t t[3] = { tile % this->Tiles[0], (tile / this->Tiles[0]) % this->Tiles[1],
+      tile / (this->Tiles[0] * this->Tiles[1]) };
+    CellBox box;
+    for (int a = 0; a < 3; ++a)
+    {
+      box.Lo[a] = b.Lo[a] + static_cast<int>(t[a]) * TileCubes;
+      box.Hi[a] = std::min(b.Hi[a], box.Lo[a] + TileCubes - 1);
+    }
+    return box;
+  }
+
+  /// Finds every node of tile `tile`, each unfound one starting a new component (numbered from
+  /// 0 in the tile) grown inside the tile only. Returns the number of components.
+  int ScanTile(std::int64_t tile)
+  {
+    SampledVolume<Values>& volume = this->Volume;
+    TileWork& w = this->Work[tile];
+    const CellBox box = this->TileBox(tile);
+    CubeSamples st;
+    CubeSurface surface;
+    int components = 0;
+    for (int k = box.Lo[2]; k <= box.Hi[2] && !volume.Stopped(); ++k)
+    {
+      for (int j = box.Lo[1]; j <= box.Hi[1]; ++j)
+      {
+        for (int i = box.Lo[0]; i <= box.Hi[0] && !volume.Stopped(); ++i)
+        {
+          if (!volume.Owned.Owns(i, j, k))
+          {
+            continue;
+          }
+          const std::int64_t bit = this->CubeBit(i, j, k);
+          if (this->AllFound(bit) || !volume.Evaluate(i, j, k, st) || st.Case == 0 ||
+            st.Case == 255)
+          {
+            continue;
+          }
+          volume.Describe(i, j, k, st, surface);
+          const int numNodes = surface.NumberOfNodes();
+          for (int node = 0; node < numNodes; ++node)
+          {
+            if (!this->NodeFound(w, bit, node, numNodes))
+            {
+              const std::size_t head = w.Queue.size();
+              this->Record(w, i, j, k, bit, st, node, numNodes, components++);
+              this->ExpandQueue(tile, head, true);
+            }
+          }
+        }
+      }
+    }
+    return components;
+  }
+
+  /// Starts a new component, grown across tiles, from every unfound node of the owned cubes in
+  /// `region` (one at a time, on this thread's schedule of rounds).
+  void ScanRegion(const CellBox& region)
   {
     SampledVolume<Values>& volume = this->Volume;
     CubeSamples st;
     CubeSurface surface;
     for (int k = region.Lo[2]; k <= region.Hi[2] && !volume.Stopped(); ++k)
     {
-      if (reportProgress)
-      {
-        volume.Report(0.5 * (k - region.Lo[2]) / (region.Hi[2] - region.Lo[2] + 1));
-      }
       for (int j = region.Lo[1]; j <= region.Hi[1]; ++j)
       {
         for (int i = region.Lo[0]; i <= region.Hi[0] && !volume.Stopped(); ++i)
@@ -331,13 +538,14 @@ private:
           }
           volume.Describe(i, j, k, st, surface);
           const int numNodes = surface.NumberOfNodes();
+          const std::int64_t tile = this->TileOf(i, j, k);
           for (int node = 0; node < numNodes; ++node)
           {
-            if (!this->NodeFound(bit, node, numNodes))
+            if (!this->NodeFound(this->Work[tile], bit, node, numNodes))
             {
-              const std::size_t head = this->Found.size();
-              this->Record(i, j, k, bit, st, node, numNodes, this->Components.Add(false));
-              this->ExpandFrom(head);
+              this->Record(this->Work[tile], i, j, k, bit, st, node, numNodes,
+                this->Components.Add(false));
+              this->Rounds({ tile });
             }
           }
         }
@@ -345,14 +553,11 @@ private:
     }
   }
 
-  static constexpr int TileCubes = 32;  // cubes along each axis of a tile of visited bits
-  static constexpr int TileWords = 512; // 64-bit words in a tile
-
   SampledVolume<Values>& Volume;
   ComponentSet& Components;
   std::int64_t Tiles[3] = { 0, 0, 0 }; // tiles along each axis of the owned box
   ZeroedArray<std::uint64_t> Visited;  // a bit per owned cube: its nodes were all found
-  KeyMap FoundNodesOfCube{ 64 };       // cubes of several nodes: the nodes found, as bits
+  std::vector<TileWork> Work;          // per tile
   std::vector<SurfaceNode> Found;
   std::int64_t NodesExpanded = 0;
 };

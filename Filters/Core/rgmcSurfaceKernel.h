@@ -51,7 +51,7 @@ public:
   std::int64_t Joins() const { return this->Extraction.Joins(); }
   std::int64_t NumberOfNodes() { return static_cast<std::int64_t>(this->Growth.Nodes().size()); }
 
-  const std::string& Error() const { return this->Volume.Error(); }
+  std::string Error() const { return this->Volume.Error(); }
   bool Aborted() const { return this->Volume.Aborted(); }
   bool MissingGhosts() const { return this->Volume.MissingGhosts(); }
 
