@@ -183,7 +183,7 @@ int main(int argc, char* argv[])
     extract->SetInputConnection(source->GetOutputPort());
     extract->SetExtractionMode(mode);
     extract->AddSeedPoint(seed[0], seed[1], seed[2]);
-    extract->Update();
+    rgmc_test::UpdateAtThreads(extract, name);
     vtkPolyData* surface = extract->GetOutput();
     const std::vector<Triangle> got = Gathered(controller, surface);
     if (rank == 0)
@@ -221,7 +221,7 @@ int main(int argc, char* argv[])
     repair->SetController(controller);
     repair->SetInputConnection(extract->GetOutputPort());
     repair->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
-    repair->Update();
+    rgmc_test::UpdateAtThreads(repair, name);
     vtkPolyData* repaired = repair->GetOutput();
     const vtkIdType unique = FieldValue(repaired, "UniquePoints");
     RGMC_CHECK(unique == FieldValue(smallRepair->GetOutput(), "UniquePoints") &&

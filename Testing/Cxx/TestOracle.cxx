@@ -17,6 +17,7 @@
 //   (exact), against our own index-space output transformed in double (1e-6 of the spacing),
 //   and against vtkMarchingCubes with a tolerance of float precision at the coordinates' size.
 #include "rgmcTestData.h"
+#include "rgmcThreads.h"
 
 #include "vtkCellData.h"
 #include "vtkFieldData.h"
@@ -47,7 +48,7 @@ vtkSmartPointer<vtkPolyData> Extract(vtkImageData* image, double isovalue,
   {
     rg->AddSeedPoint(s[0], s[1], s[2]);
   }
-  rg->Update();
+  rgmc_test::UpdateAtThreads(rg, "extraction");
   auto out = vtkSmartPointer<vtkPolyData>::New();
   out->ShallowCopy(rg->GetOutput());
   return out;
@@ -334,8 +335,9 @@ void Geometry()
 
 } // namespace
 
-int main()
+int main(int argc, char* argv[])
 {
+  rgmc_test::ParseThreads(argc, argv);
   Blobs();
   Phantom();
   EqualSamples();

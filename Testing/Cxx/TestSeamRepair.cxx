@@ -106,7 +106,14 @@ Repaired Repair(vtkMultiProcessController* controller, vtkPolyData* input, int m
   repair->SetInputData(input);
   repair->SetSmoothingMethod(method);
   repair->SetWindowFunction(window);
-  repair->Update();
+  UpdateAtThreads(repair,
+    "Seam Repair, method " + std::to_string(method) +
+      (input->GetPointData()->GetGlobalIds() ? " keyed" : " unkeyed"),
+    [&catcher]()
+    {
+      catcher->Errors.clear();
+      catcher->Warnings.clear();
+    });
   Repaired r;
   r.Output = vtkSmartPointer<vtkPolyData>::New();
   r.Output->ShallowCopy(repair->GetOutput());

@@ -4,6 +4,7 @@
 #define rgmcDistributedData_h
 
 #include "rgmcTestData.h"
+#include "rgmcThreads.h"
 
 #include "vtkExtentTranslator.h"
 #include "vtkMultiProcessController.h"
@@ -166,7 +167,12 @@ inline Run Extract(vtkMultiProcessController* controller, vtkImageData* image, d
   {
     tweak(rg);
   }
-  rg->Update();
+  UpdateAtThreads(rg, "extraction",
+    [&catcher]()
+    {
+      catcher->Errors.clear();
+      catcher->Warnings.clear();
+    });
   Run r;
   r.Output = vtkSmartPointer<vtkPolyData>::New();
   r.Output->ShallowCopy(rg->GetOutput());

@@ -8,6 +8,7 @@
 #include "vtkSmartPointer.h"
 
 #include "rgmcCheck.h"
+#include "rgmcThreads.h"
 
 #include <iostream>
 #include <string>
@@ -19,6 +20,7 @@ namespace rgmc_test
 /// --dummy, else MPI) and makes it the global one, for the filters' defaults.
 inline vtkSmartPointer<vtkMultiProcessController> StartController(int& argc, char**& argv)
 {
+  ParseThreads(argc, argv); // --threads N anywhere: the filters on N threads too
   vtkSmartPointer<vtkMultiProcessController> controller;
   if (argc > 1 && std::string(argv[1]) == "--dummy")
   {
@@ -35,8 +37,8 @@ inline vtkSmartPointer<vtkMultiProcessController> StartController(int& argc, cha
 
 /// Ends an MPI test: the failed checks summed over the ranks, said by rank 0 after `name`
 /// ("TestX on N ranks: ..." plus `detail`), the controller finalized; returns main's status.
-inline int Finish(vtkMultiProcessController* controller, const std::string& name,
-  const std::string& detail = "")
+inline int Finish(
+  vtkMultiProcessController* controller, const std::string& name, const std::string& detail = "")
 {
   long long failures = Failures(), total = 0;
   controller->AllReduce(&failures, &total, 1, vtkCommunicator::SUM_OP);

@@ -1,0 +1,172 @@
+// Threads in the tests: a test run with `--threads N` updates the project's filters under
+// vtkSMPTools with the STDThread backend and N threads, and also with 1 thread, and checks that
+// the two outputs are bitwise identical (every array of the output, in order); its own checks
+// then run on the N-thread output. Without --threads, filters update as configured.
+#ifndef rgmcThreads_h
+#define rgmcThreads_h
+
+#include "rgmcCheck.h"
+
+#include "vtkAbstractArray.h"
+#include "vtkAlgorithm.h"
+#include "vtkAlgorithmOutput.h"
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkDataObject.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkFieldData.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <string>
+
+namespace rgmc_test
+{
+
+/// The thread count of this run (1 unless --threads N was given).
+inline int& ThreadCount()
+{
+  static int threads = 1;
+  return threads;
+}
+
+/// Takes `--threads N` out of the arguments.
+inline void ParseThreads(int& argc, char** argv)
+{
+  for (int a = 1; a + 1 < argc; ++a)
+  {
+    if (std::string(argv[a]) == "--threads")
+    {
+      ThreadCount() = std::atoi(argv[a + 1]);
+      for (int b = a; b + 2 <= argc; ++b)
+      {
+        argv[b] = argv[b + 2];
+      }
+      argc -= 2;
+      return;
+    }
+  }
+}
+
+/// Whether two arrays hold the same bytes (same type, tuples and components).
+inline bool SameBits(vtkAbstractArray* a, vtkAbstractArray* b)
+{
+  if (!a || !b) // no array and an empty array are the same
+  {
+    return (!a || a->GetNumberOfTuples() == 0) && (!b || b->GetNumberOfTuples() == 0);
+  }
+  if (a->GetDataType() != b->GetDataType() || a->GetNumberOfTuples() != b->GetNumberOfTuples() ||
+    a->GetNumberOfComponents() != b->GetNumberOfComponents())
+  {
+    return false;
+  }
+  const vtkIdType bytes = a->GetNumberOfValues() * a->GetDataTypeSize();
+  return bytes == 0 || std::memcmp(a->GetVoidPointer(0), b->GetVoidPointer(0), bytes) == 0;
+}
+
+inline std::string DifferentArray(vtkFieldData* a, vtkFieldData* b, const char* where)
+{
+  if (a->GetNumberOfArrays() != b->GetNumberOfArrays())
+  {
+    return std::string("the number of ") + where + " arrays";
+  }
+  for (int i = 0; i < a->GetNumberOfArrays(); ++i)
+  {
+    vtkAbstractArray* x = a->GetAbstractArray(i);
+    vtkAbstractArray* y = x->GetName() ? b->GetAbstractArray(x->GetName()) : b->GetAbstractArray(i);
+    if (!SameBits(x, y))
+    {
+      return std::string(where) + " array " + (x->GetName() ? x->GetName() : "(unnamed)");
+    }
+  }
+  return std::string();
+}
+
+/// What differs between two outputs ("" when bitwise the same).
+inline std::string Difference(vtkDataObject* a, vtkDataObject* b)
+{
+  vtkPolyData* pa = vtkPolyData::SafeDownCast(a);
+  vtkPolyData* pb = vtkPolyData::SafeDownCast(b);
+  if (!pa || !pb)
+  {
+    return pa == pb ? "" : "the output type";
+  }
+  if (!SameBits(pa->GetPoints() ? pa->GetPoints()->GetData() : nullptr,
+        pb->GetPoints() ? pb->GetPoints()->GetData() : nullptr))
+  {
+    return "the points";
+  }
+  if (!SameBits(pa->GetPolys()->GetConnectivityArray(), pb->GetPolys()->GetConnectivityArray()) ||
+    !SameBits(pa->GetPolys()->GetOffsetsArray(), pb->GetPolys()->GetOffsetsArray()))
+  {
+    return "the triangles";
+  }
+  std::string d = DifferentArray(pa->GetPointData(), pb->GetPointData(), "point");
+  if (d.empty())
+  {
+    d = DifferentArray(pa->GetCellData(), pb->GetCellData(), "cell");
+  }
+  if (d.empty())
+  {
+    d = DifferentArray(pa->GetFieldData(), pb->GetFieldData(), "field");
+  }
+  return d;
+}
+
+/// Marks `algorithm` and everything upstream of it modified, so that all of it runs again.
+inline void ModifiedUpstream(vtkAlgorithm* algorithm)
+{
+  algorithm->Modified();
+  for (int port = 0; port < algorithm->GetNumberOfInputPorts(); ++port)
+  {
+    for (int c = 0; c < algorithm->GetNumberOfInputConnections(port); ++c)
+    {
+      ModifiedUpstream(algorithm->GetInputConnection(port, c)->GetProducer());
+    }
+  }
+}
+
+/// Updates `algorithm` (its output port 0) at ThreadCount() threads; with more than 1, first
+/// on 1 thread, and checks that both outputs are bitwise identical. `what` names the case;
+/// `between` runs between the two updates (to forget the first run's messages).
+inline void UpdateAtThreads(
+  vtkAlgorithm* algorithm, const std::string& what, const std::function<void()>& between = nullptr)
+{
+  const int threads = ThreadCount();
+  if (threads <= 1)
+  {
+    algorithm->Update();
+    return;
+  }
+  vtkSmartPointer<vtkDataObject> single;
+  vtkSMPTools::LocalScope(vtkSMPTools::Config{ 1, "STDThread", false },
+    [&]()
+    {
+      ModifiedUpstream(algorithm);
+      algorithm->Update();
+      single.TakeReference(algorithm->GetOutputDataObject(0)->NewInstance());
+      single->DeepCopy(algorithm->GetOutputDataObject(0));
+    });
+  if (between)
+  {
+    between();
+  }
+  vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+    [&]()
+    {
+      ModifiedUpstream(algorithm);
+      algorithm->Update();
+    });
+  const std::string d = Difference(single, algorithm->GetOutputDataObject(0));
+  RGMC_CHECK(d.empty(), what << ": " << d << " differ between 1 and " << threads << " threads");
+}
+
+} // namespace rgmc_test
+
+#endif
