@@ -6,6 +6,7 @@
 #include "rgmcSurfaceKernel.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
+#include "vtkRGThreads.h"
 
 #include "vtkArrayDispatch.h"
 #include "vtkCellArray.h"
@@ -31,7 +32,6 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTypeInt32Array.h"
@@ -970,9 +970,10 @@ void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
   };
   // Threads within the rank: vtkSMPTools, so ParaView's and VTK's settings govern them
   // (VTK_SMP_BACKEND_IN_USE, VTK_SMP_MAX_THREADS). Each index is a large task (a tile, a chunk).
-  options.ParallelFor = [](std::int64_t count, const std::function<void(std::int64_t, std::int64_t)>& body)
+  options.ParallelFor =
+    [](std::int64_t count, const std::function<void(std::int64_t, std::int64_t)>& body)
   {
-    vtkSMPTools::For(vtkIdType(0), static_cast<vtkIdType>(count), vtkIdType(1),
+    rgmc::ParallelFor(static_cast<vtkIdType>(count), vtkIdType(1),
       [&body](vtkIdType begin, vtkIdType end) { body(begin, end); });
   };
   MakeKernel make{ run.grid.get(), run.own.get(), &options, nullptr };

@@ -7,6 +7,7 @@
 #include "rgmcSmoothing.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
+#include "vtkRGThreads.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
@@ -51,6 +52,8 @@ namespace
 using rgmc::Ranks;
 constexpr int NumberingTag = 48800, AnswerTag = 48802, EdgesTag = 48804, RequestTag = 48806,
               StateTag = 48808, UpdateTag = 48810, NormalTag = 48812, NormalBackTag = 48814;
+/// Rows (vertices) per range when smoothing and normals run on threads.
+constexpr vtkIdType RowGrain = 512;
 
 // ---- vertex identities -----------------------------------------------------------------------
 
@@ -843,7 +846,12 @@ public:
           break;
         }
         this->Fetch(current.data());
-        rgmc::LaplacianStep(this->Stencil, this->Owned, current.data(), next.data(), relaxation);
+        rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
+          [&](vtkIdType first, vtkIdType last)
+          {
+            rgmc::LaplacianStep(
+              this->Stencil, this->Owned, current.data(), next.data(), relaxation, first, last);
+          });
         this->Update(next.data());
         std::swap(current, next);
       }
@@ -861,7 +869,12 @@ public:
       T* x1 = b.data();
       T* x2 = c.data();
       this->Fetch(x0);
-      rgmc::SincFirstStep(this->Stencil, this->Owned, x0, x1, sum.data(), coefficients.data());
+      rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
+        [&](vtkIdType first, vtkIdType last)
+        {
+          rgmc::SincFirstStep(
+            this->Stencil, this->Owned, x0, x1, sum.data(), coefficients.data(), first, last);
+        });
       this->Update(x1);
       for (int it = 2; it <= iterations; ++it)
       {
@@ -871,7 +884,12 @@ public:
           break;
         }
         this->Fetch(x1);
-        rgmc::SincStep(this->Stencil, this->Owned, x0, x1, x2, sum.data(), coefficients[it]);
+        rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
+          [&](vtkIdType first, vtkIdType last)
+          {
+            rgmc::SincStep(
+              this->Stencil, this->Owned, x0, x1, x2, sum.data(), coefficients[it], first, last);
+          });
         this->Update(x2);
         T* oldest = x0;
         x0 = x1;
@@ -939,11 +957,12 @@ public:
         terms.push_back(term(corners[c] / 3));
       }
     };
-    auto sum = [&](double n[3])
+    // The normal of a vertex: its terms summed in the order of their keys.
+    auto SumTerms = [](std::vector<Term>& list, double n[3])
     {
-      std::sort(terms.begin(), terms.end());
+      std::sort(list.begin(), list.end());
       n[0] = n[1] = n[2] = 0;
-      for (const Term& t : terms)
+      for (const Term& t : list)
       {
         for (int k = 0; k < 3; ++k)
         {
@@ -952,6 +971,7 @@ public:
       }
       vtkMath::Normalize(n);
     };
+    auto sum = [&](double n[3]) { SumTerms(terms, n); };
 
     // The terms of shared vertices go to their owners (in gid order, as the owners list them).
     std::vector<double> n;
@@ -984,11 +1004,21 @@ public:
     if (!this->R.Step("compute normals", problem,
           [&]()
           {
-            for (vtkIdType v = 0; v < this->N; ++v)
-            {
-              localTerms(v);
-              sum(&n[3 * v]);
-            }
+            // Each vertex's own terms, on threads (each range with its own list of terms).
+            rgmc::ParallelFor(this->N, RowGrain,
+              [&](vtkIdType first, vtkIdType last)
+              {
+                std::vector<Term> own;
+                for (vtkIdType v = first; v < last; ++v)
+                {
+                  own.clear();
+                  for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
+                  {
+                    own.push_back(term(corners[c] / 3));
+                  }
+                  SumTerms(own, &n[3 * v]);
+                }
+              });
             // Owned shared vertices: their own terms and every holder's, in the same order.
             std::vector<std::size_t> cursor(this->R.Size, 0);
             std::vector<std::pair<vtkIdType, int>> order; // (gid, sharer) of owned shared vertices

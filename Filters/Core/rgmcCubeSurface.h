@@ -48,8 +48,8 @@ struct SurfaceOptions
   /// Runs body(begin, end) over ranges that cover [0, count) exactly once, possibly on several
   /// threads at once (the VTK layer passes vtkSMPTools::For). Empty: one range on this thread.
   /// The results never depend on how the ranges are cut or run.
-  std::function<void(std::int64_t count,
-    const std::function<void(std::int64_t begin, std::int64_t end)>& body)>
+  std::function<void(
+    std::int64_t count, const std::function<void(std::int64_t begin, std::int64_t end)>& body)>
     ParallelFor;
 };
 

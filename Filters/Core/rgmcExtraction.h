@@ -13,8 +13,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace rgmc
@@ -424,7 +424,8 @@ private:
   }
 
   /// Emits the triangles of one node.
-  void Emit(ChunkWork& work, const SurfaceNode& n, const CubeSamples& st, const CubeSurface& surface)
+  void Emit(
+    ChunkWork& work, const SurfaceNode& n, const CubeSamples& st, const CubeSurface& surface)
   {
     LocalMesh& m = work.Out->Mesh;
     surface.ForEachTriangle(n.Node,
@@ -464,8 +465,8 @@ private:
         for (std::int32_t id : chunk.BottomPlane)
         {
           const std::int64_t key = chunk.Mesh.Keys[id];
-          auto it = std::lower_bound(
-            theirs.begin(), theirs.end(), std::make_pair(key, std::int32_t(-1)));
+          auto it =
+            std::lower_bound(theirs.begin(), theirs.end(), std::make_pair(key, std::int32_t(-1)));
           if (it != theirs.end() && it->first == key)
           {
             chunk.FinalId[id] = -1 - it->second; // the chunk below's vertex

@@ -191,10 +191,7 @@ private:
   }
 
   bool AllFound(std::int64_t bit) const { return (this->Visited[bit >> 6] >> (bit & 63)) & 1u; }
-  void SetAllFound(std::int64_t bit)
-  {
-    this->Visited[bit >> 6] |= std::uint64_t(1) << (bit & 63);
-  }
+  void SetAllFound(std::int64_t bit) { this->Visited[bit >> 6] |= std::uint64_t(1) << (bit & 63); }
 
   bool NodeFound(TileWork& w, std::int64_t bit, int node, int numNodes) const
   {
@@ -212,8 +209,8 @@ private:
 
   /// Records node `node` of cube (i, j, k) found and queues it in its tile. Cubes with one node
   /// use only the bit per cube; cubes with several remember which were found.
-  void Record(TileWork& w, int i, int j, int k, std::int64_t bit, const CubeSamples& st,
-    int node, int numNodes, int comp)
+  void Record(TileWork& w, int i, int j, int k, std::int64_t bit, const CubeSamples& st, int node,
+    int numNodes, int comp)
   {
     if (numNodes == 1)
     {
@@ -309,8 +306,8 @@ private:
             }
             else if (!keepInTile)
             {
-              w.Outbox.push_back(Crossing{ v.Key, i, j, k, n.Component,
-                static_cast<std::int8_t>(edge) });
+              w.Outbox.push_back(
+                Crossing{ v.Key, i, j, k, n.Component, static_cast<std::int8_t>(edge) });
             }
           });
       });
@@ -543,8 +540,8 @@ private:
           {
             if (!this->NodeFound(this->Work[tile], bit, node, numNodes))
             {
-              this->Record(this->Work[tile], i, j, k, bit, st, node, numNodes,
-                this->Components.Add(false));
+              this->Record(
+                this->Work[tile], i, j, k, bit, st, node, numNodes, this->Components.Add(false));
               this->Rounds({ tile });
             }
           }

@@ -10,6 +10,7 @@
 #ifndef rgmcSmoothing_h
 #define rgmcSmoothing_h
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -135,14 +136,17 @@ struct Stencils
   }
 };
 
+// Each step below updates the rows [first, last) (all by default); rows are independent, so
+// ranges of rows may run on threads at once with the same result.
+
 /// One Jacobi Laplacian step for the vertices `points[r]` with stencil row r:
 /// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T
 /// (Seam Repair iterates in double and rounds to the points' type once, at the end).
 template <typename T>
 void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* cur,
-  T* next, double relaxation)
+  T* next, double relaxation, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
-  for (std::size_t r = 0; r < points.size(); ++r)
+  for (std::size_t r = first; r < std::min(last, points.size()); ++r)
   {
     const std::int64_t v = points[r];
     const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
@@ -186,9 +190,9 @@ void SincDelta(const Stencils& stencils, std::size_t r, std::int64_t v, const T*
 /// x3 = c0 x0 + c1 x1 (x1 before it is stored).
 template <typename T>
 void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* x0,
-  T* x1, T* x3, const double* c)
+  T* x1, T* x3, const double* c, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
-  for (std::size_t r = 0; r < points.size(); ++r)
+  for (std::size_t r = first; r < std::min(last, points.size()); ++r)
   {
     const std::int64_t v = points[r];
     double delta[3];
@@ -207,9 +211,9 @@ void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& po
 /// is stored).
 template <typename T>
 void SincStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* x0,
-  const T* x1, T* x2, T* x3, double c)
+  const T* x1, T* x2, T* x3, double c, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
-  for (std::size_t r = 0; r < points.size(); ++r)
+  for (std::size_t r = first; r < std::min(last, points.size()); ++r)
   {
     const std::int64_t v = points[r];
     double delta[3];
