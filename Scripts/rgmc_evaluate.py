@@ -21,6 +21,14 @@ The scale benchmark instead: the build's rgmcScale program on 1 and 2 ranks, a 5
 (about 54 million triangles, one surface through every partition plane) through extraction,
 Seam Repair, 5 Laplacian iterations and the merged writer (STL, then PLY), with the seconds of
 each stage (its slowest rank's) and each rank's peak memory. Writes scale.md and scale.json.
+
+  python3 Scripts/rgmc_evaluate.py --threads  # or: ./rgmc evaluate --threads
+
+The threads benchmark instead: the build's rgmcThreads program, one rank, the CT phantom
+(512^3) at 1 and 2 threads through vtkSMPTools (STDThread unless --backend says otherwise; the
+backend that ran is recorded): vtkFlyingEdges3D, our seeded and all-components modes, Seam
+Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at every
+thread count. Writes threads.md and threads.json.
 """
 
 import argparse
@@ -362,6 +370,60 @@ def scale_report(rows, args):
     return "\n".join(lines)
 
 
+def run_threads(args):
+    command = [args.threads_binary, "--size", str(args.threads_size), "--threads",
+               args.thread_counts, "--repeats", str(args.threads_repeats), "--backend", args.backend]
+    print("+ " + " ".join(command), flush=True)
+    process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
+    if process.returncode != 0:
+        raise rgmc_common.UsageError("rgmcThreads failed (exit %d)" % process.returncode)
+    return json.loads(process.stdout)
+
+
+def threads_report(result, args):
+    runs = result["runs"]
+    one = runs[0]
+    lines = ["# RGMC threads benchmark", "",
+             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
+             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+             "The CT phantom at %d^3 on one rank, isovalue 400; seeded on the skull (0, 0, 105). "
+             "Minimum of %d runs. Seam Repair + 20 Laplacian iterations (relaxation 0.01) on the "
+             "seeded surface." % (result["size"], result["repeats"]), "",
+             "| threads | backend | vtkFlyingEdges3D (s) | seeded (s) | all components (s) | "
+             "Seam Repair + 20 Laplacian (s) | seeded / FE | bitwise same as 1 thread |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in runs:
+        lines.append("| %d | %s | %.3f | %.3f | %.3f | %.3f | %.2f | %s |" % (
+            r["threads"], r["backend"], r["flying_edges"], r["seeded"], r["all_components"],
+            r["seam_repair_laplacian20"], r["seeded"] / r["flying_edges"],
+            "yes" if r["identical_to_first"] else "NO"))
+    lines += ["", "Triangles: vtkFlyingEdges3D %d, seeded %d, all components %d." % (
+        one["flying_edges_triangles"], one["seeded_triangles"], one["all_triangles"]), ""]
+    lines += ["Speed-ups over 1 thread:", ""]
+    for r in runs[1:]:
+        for key, name in (("flying_edges", "vtkFlyingEdges3D"), ("seeded", "seeded"),
+                          ("all_components", "all components"),
+                          ("seam_repair_laplacian20", "Seam Repair + 20 Laplacian")):
+            lines.append("- %s, %d threads: %.2fx" % (name, r["threads"], one[key] / r[key]))
+    lines += ["", "Targets (issue 14), met or not:", ""]
+    two = [r for r in runs if r["threads"] == 2]
+    if two:
+        t = two[0]
+        lines.append("- seeded from 2 threads >= 1.7x: %.2fx, %s" % (
+            one["seeded"] / t["seeded"], "met" if one["seeded"] / t["seeded"] >= 1.7 else "NOT met"))
+        lines.append("- all components from 2 threads >= 1.7x: %.2fx, %s" % (
+            one["all_components"] / t["all_components"],
+            "met" if one["all_components"] / t["all_components"] >= 1.7 else "NOT met"))
+        for r in (one, t):
+            ratio = r["seeded"] / r["flying_edges"]
+            lines.append("- seeded <= 0.5x FE at %d thread%s: %.2fx, %s" % (
+                r["threads"], "s" if r["threads"] > 1 else "", ratio, "met" if ratio <= 0.5 else "NOT met"))
+        ratio = one["seam_repair_laplacian20"] / t["seam_repair_laplacian20"]
+        lines.append("- Seam Repair + 20 Laplacian from 2 threads >= 1.6x: %.2fx, %s" % (
+            ratio, "met" if ratio >= 1.6 else "NOT met"))
+    return "\n".join(lines) + "\n"
+
+
 def main(argv):
     parser = argparse.ArgumentParser(prog="rgmc_evaluate.py", description=__doc__.split("\n")[0])
     parser.add_argument("--cases", default="phantom256,phantom512,sphere512,blobs,mri")
@@ -380,11 +442,31 @@ def main(argv):
     parser.add_argument("--scale-size", type=int, default=512, help="the gyroid's points per axis")
     parser.add_argument("--scale-period", type=float, default=24, help="the gyroid's period in voxels")
     parser.add_argument("--scale-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcScale"))
+    parser.add_argument("--threads", action="store_true",
+                        help="the threads benchmark instead (rgmcThreads, one rank)")
+    parser.add_argument("--thread-counts", default="1,2", help="thread counts of --threads")
+    parser.add_argument("--threads-size", type=int, default=512, help="the phantom's points per axis")
+    parser.add_argument("--threads-repeats", type=int, default=3)
+    parser.add_argument("--backend", default="STDThread", help="the vtkSMPTools backend of --threads")
+    parser.add_argument("--threads-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcThreads"))
     parser.add_argument("--report-only", action="store_true",
                         help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)
     args.cases = [c for c in args.cases.split(",") if c]
     args.ranks = sorted(int(r) for r in (args.ranks or ("1,2" if args.scale else "1,2,4")).split(","))
+    if args.threads:
+        if not os.path.isfile(args.threads_binary):
+            raise rgmc_common.UsageError("no threads program at %s: build first (./rgmc build)" % args.threads_binary)
+        os.makedirs(args.output, exist_ok=True)
+        result = run_threads(args)
+        with open(os.path.join(args.output, "threads.json"), "w") as out:
+            json.dump(result, out, indent=1)
+        text = threads_report(result, args)
+        with open(os.path.join(args.output, "threads.md"), "w") as out:
+            out.write(text)
+        print("\n" + text)
+        print("written: %s" % os.path.join(args.output, "threads.md"))
+        return 0
     if args.scale:
         if not os.path.isfile(args.scale_binary):
             raise rgmc_common.UsageError("no scale program at %s: build first (./rgmc build)" % args.scale_binary)
