@@ -485,21 +485,23 @@ public:
     std::vector<std::pair<vtkIdType, vtkIdType>> ends; // (gid, vertex) of edge ends
     // The corners of the triangles at each vertex, in compressed rows.
     std::vector<vtkIdType> cornerOffsets, corners;
-    // The ends of this rank's edges at vertex v (once per triangle side), sorted by gid.
-    auto localEnds = [&](vtkIdType v)
+    // The ends of this rank's edges at vertex v (once per triangle side), sorted by gid, into
+    // `out` (reads only: threads may call it at once).
+    auto endsAt = [&](vtkIdType v, std::vector<std::pair<vtkIdType, vtkIdType>>& out)
     {
-      ends.clear();
+      out.clear();
       for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
       {
         const vtkIdType t = corners[c] / 3, k = corners[c] % 3;
         for (vtkIdType other : { (k + 1) % 3, (k + 2) % 3 })
         {
           const vtkIdType w = static_cast<vtkIdType>(this->Triangles[3 * t + other]);
-          ends.emplace_back(gid[w], w);
+          out.emplace_back(gid[w], w);
         }
       }
-      std::sort(ends.begin(), ends.end());
+      std::sort(out.begin(), out.end());
     };
+    auto localEnds = [&](vtkIdType v) { endsAt(v, ends); };
     // This rank's edges at vertex v, sorted by the neighbour's gid, into `out`.
     auto localNeighbours = [&](vtkIdType v, std::vector<Neighbour>& out)
     {
@@ -685,38 +687,92 @@ public:
             };
             // Vertices no other rank holds, in memory order: most are inside a closed manifold
             // piece of the surface, where every edge has two triangles and the stencil is simply
-            // the neighbours in gid order.
-            for (vtkIdType v = 0; v < this->N; ++v)
+            // the neighbours in gid order. Those are found on threads, in blocks of vertices
+            // (each block's rows kept apart), then taken block by block in order, the others
+            // going through the general path there: the same rows, in the same order, for any
+            // number of threads.
+            struct Block
             {
-              if (this->Num.Holding[v] != Numbering::Alone)
-              {
-                continue;
-              }
-              localEnds(v);
-              bool manifold = !ends.empty() && ends.size() < 2 * 255;
-              for (std::size_t e = 0; e < ends.size() && manifold; e += 2)
-              {
-                manifold = e + 1 < ends.size() && ends[e + 1].first == ends[e].first &&
-                  (e + 2 == ends.size() || ends[e + 2].first != ends[e].first);
-              }
-              if (!manifold)
-              {
-                general(v, false, 0);
-                continue;
-              }
-              for (std::size_t e = 0; e < ends.size(); e += 2)
-              {
-                checks.Edges += ends[e].first > gid[v];
-              }
-              if (stencils)
-              {
-                this->Owned.push_back(v);
-                for (std::size_t e = 0; e < ends.size(); e += 2)
+              std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex of the general path
+              std::vector<vtkIdType> Offsets;  // row starts in Neighbours, per manifold vertex
+              std::vector<vtkIdType> Neighbours;
+              vtkIdType Edges = 0;
+            };
+            // Batches of blocks bound the rows held apart (memory), whatever the mesh's size.
+            const vtkIdType blockSize = 4096, batchBlocks = 64;
+            const vtkIdType numBlocks = (this->N + blockSize - 1) / blockSize;
+            std::vector<Block> blocks;
+            for (vtkIdType batch = 0; batch < numBlocks; batch += batchBlocks)
+            {
+              blocks.assign(
+                static_cast<std::size_t>(std::min(batchBlocks, numBlocks - batch)), Block());
+              rgmc::ParallelFor(static_cast<vtkIdType>(blocks.size()), 1,
+                [&](vtkIdType first, vtkIdType last)
                 {
-                  this->Stencil.Neighbours.push_back(ends[e].second);
+                  std::vector<std::pair<vtkIdType, vtkIdType>> blockEnds;
+                  for (vtkIdType b = first; b < last; ++b)
+                  {
+                    Block& block = blocks[b];
+                    const vtkIdType start = (batch + b) * blockSize;
+                    for (vtkIdType v = start; v < std::min(this->N, start + blockSize); ++v)
+                    {
+                      if (this->Num.Holding[v] != Numbering::Alone)
+                      {
+                        continue;
+                      }
+                      endsAt(v, blockEnds);
+                      bool manifold = !blockEnds.empty() && blockEnds.size() < 2 * 255;
+                      for (std::size_t e = 0; e < blockEnds.size() && manifold; e += 2)
+                      {
+                        manifold = e + 1 < blockEnds.size() &&
+                          blockEnds[e + 1].first == blockEnds[e].first &&
+                          (e + 2 == blockEnds.size() ||
+                            blockEnds[e + 2].first != blockEnds[e].first);
+                      }
+                      if (!manifold)
+                      {
+                        block.Vertices.push_back(-1 - v);
+                        continue;
+                      }
+                      block.Vertices.push_back(v);
+                      block.Offsets.push_back(static_cast<vtkIdType>(block.Neighbours.size()));
+                      for (std::size_t e = 0; e < blockEnds.size(); e += 2)
+                      {
+                        block.Edges += blockEnds[e].first > gid[v];
+                        if (stencils)
+                        {
+                          block.Neighbours.push_back(blockEnds[e].second);
+                        }
+                      }
+                    }
+                  }
+                });
+              for (Block& block : blocks)
+              {
+                checks.Edges += block.Edges;
+                std::size_t row = 0;
+                for (const vtkIdType entry : block.Vertices)
+                {
+                  if (entry < 0)
+                  {
+                    general(-1 - entry, false, 0);
+                    continue;
+                  }
+                  if (stencils)
+                  {
+                    this->Owned.push_back(entry);
+                    const vtkIdType begin = block.Offsets[row];
+                    const vtkIdType end = row + 1 < block.Offsets.size()
+                      ? block.Offsets[row + 1]
+                      : static_cast<vtkIdType>(block.Neighbours.size());
+                    this->Stencil.Neighbours.insert(this->Stencil.Neighbours.end(),
+                      block.Neighbours.begin() + begin, block.Neighbours.begin() + end);
+                    this->Stencil.Offsets.push_back(
+                      static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+                  }
+                  ++row;
                 }
-                this->Stencil.Offsets.push_back(
-                  static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+                block = Block();
               }
             }
             // Shared vertices this rank owns, in gid order (the order of the received edges).
