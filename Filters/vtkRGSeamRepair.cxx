@@ -139,7 +139,7 @@ LocalVertices MergeLocal(
     }
     all[p].second = p;
   }
-  std::sort(all.begin(), all.end());
+  rgmc::ParallelSort(all); // (identity, point) pairs are distinct
   LocalVertices local;
   bool duplicates = false;
   for (std::size_t i = 1; i < all.size() && !duplicates; ++i)

@@ -8,9 +8,11 @@
 #include "vtkSMPTools.h"
 #include "vtkType.h"
 
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <vector>
 
 namespace rgmc
 {
@@ -48,6 +50,54 @@ void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
   if (failure)
   {
     std::rethrow_exception(failure);
+  }
+}
+
+/// Sorts [begin, end) on threads: fixed slices (not one per thread) sorted at once, then merged
+/// pairwise in rounds. The elements must be totally ordered (no two equal), so that the result
+/// is the one std::sort gives, whatever the threads. Needs a buffer of the range's size.
+template <typename T>
+void ParallelSort(std::vector<T>& values)
+{
+  const std::size_t n = values.size();
+  const std::size_t slice = std::max<std::size_t>(4096, (n + 63) / 64);
+  if (n <= slice)
+  {
+    std::sort(values.begin(), values.end());
+    return;
+  }
+  const vtkIdType slices = static_cast<vtkIdType>((n + slice - 1) / slice);
+  ParallelFor(slices, 1,
+    [&](vtkIdType first, vtkIdType last)
+    {
+      for (vtkIdType s = first; s < last; ++s)
+      {
+        const std::size_t a = static_cast<std::size_t>(s) * slice;
+        std::sort(values.begin() + a, values.begin() + std::min(n, a + slice));
+      }
+    });
+  std::vector<T> buffer(n);
+  std::vector<T>* from = &values;
+  std::vector<T>* to = &buffer;
+  for (std::size_t run = slice; run < n; run *= 2)
+  {
+    const vtkIdType pairs = static_cast<vtkIdType>((n + 2 * run - 1) / (2 * run));
+    ParallelFor(pairs, 1,
+      [&](vtkIdType first, vtkIdType last)
+      {
+        for (vtkIdType p = first; p < last; ++p)
+        {
+          const std::size_t a = static_cast<std::size_t>(p) * 2 * run;
+          const std::size_t b = std::min(n, a + run), c = std::min(n, a + 2 * run);
+          std::merge(from->begin() + a, from->begin() + b, from->begin() + b, from->begin() + c,
+            to->begin() + a);
+        }
+      });
+    std::swap(from, to);
+  }
+  if (from != &values)
+  {
+    values.swap(buffer);
   }
 }
 
