@@ -395,7 +395,7 @@ private:
         TileWork& w = this->Work[tile];
         this->Found.insert(this->Found.end(), w.Queue.begin(), w.Queue.end());
         this->NodesExpanded += static_cast<std::int64_t>(w.Queue.size());
-        w.Queue.clear();
+        std::vector<SurfaceNode>().swap(w.Queue); // its memory too: Found holds the nodes now
         for (const Crossing& c : w.Outbox)
         {
           const std::int64_t to = this->TileOf(c.I, c.J, c.K);
