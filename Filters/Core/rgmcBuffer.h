@@ -144,7 +144,8 @@ public:
 #ifdef RGMC_HAVE_MMAP
     if (this->Bytes >= (std::size_t(1) << 20))
     {
-      void* p = mmap(nullptr, this->Bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      void* p =
+        mmap(nullptr, this->Bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
       if (p == MAP_FAILED)
       {
         throw std::bad_alloc();
@@ -160,8 +161,14 @@ public:
       throw std::bad_alloc();
     }
   }
-  T& operator[](std::size_t i) { return this->Data[i]; }
-  const T& operator[](std::size_t i) const { return this->Data[i]; }
+  T& operator[](std::size_t i)
+  {
+    return this->Data[i];
+  }
+  const T& operator[](std::size_t i) const
+  {
+    return this->Data[i];
+  }
 
 private:
   void Free()

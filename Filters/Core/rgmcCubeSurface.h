@@ -139,7 +139,7 @@ constexpr std::array<int, 12> CubeEdgeAxis = CubeEdgeAxes();
 /// around the edge leaving p along `axis` (edge: that cube's edge carrying it), or the 8 cubes
 /// around p when axis < 0 (edge -1). Cubes outside the volume are included: callers check.
 template <typename F>
-void ForCubesAround(const int p[3], int axis, F&& f)
+RGMC_INLINE void ForCubesAround(const int p[3], int axis, F&& f)
 {
   for (int d = 0; d < 8; ++d)
   {
@@ -163,8 +163,8 @@ void ForCubesAround(const int p[3], int axis, F&& f)
 class CubeSurface
 {
 public:
-  void Set(const CaseTable& table, const Grid& grid, double isovalue, int i, int j, int k,
-    const CubeSamples& samples)
+  RGMC_INLINE void Set(const CaseTable& table, const Grid& grid, double isovalue, int i, int j,
+    int k, const CubeSamples& samples)
   {
     this->Entry = &table[samples.Case];
     this->GridOf = &grid;
@@ -187,7 +187,7 @@ public:
 
   /// The nodes that have the vertex `key`, on the cube's edge `edge` (-1 for a grid-point
   /// key), as bits.
-  unsigned NodesWithVertex(std::int64_t key, int edge) const
+  RGMC_INLINE unsigned NodesWithVertex(std::int64_t key, int edge) const
   {
     if (!this->IsDegenerate)
     {
@@ -210,7 +210,7 @@ public:
 
   /// f(vertex) once for each vertex of `node`, or of every node when node < 0.
   template <typename F>
-  void ForEachVertex(int node, F&& f) const
+  RGMC_INLINE void ForEachVertex(int node, F&& f) const
   {
     if (!this->IsDegenerate)
     {
@@ -241,7 +241,7 @@ public:
 
   /// f(triangle) for each triangle of `node` (3 vertices, the table's orientation).
   template <typename F>
-  void ForEachTriangle(int node, F&& f) const
+  RGMC_INLINE void ForEachTriangle(int node, F&& f) const
   {
     if (!this->IsDegenerate)
     {
@@ -267,7 +267,7 @@ public:
   }
 
   /// The vertex on edge e of the cube (not collapsed).
-  SurfaceVertex EdgeVertex(int e) const
+  RGMC_INLINE SurfaceVertex EdgeVertex(int e) const
   {
     SurfaceVertex x;
     const int* o = CornerOffset[EdgeCorners[e][0]];
@@ -465,7 +465,12 @@ public:
   }
   bool Aborted() const { return this->AbortFlag; }
   /// Whether the work should stop: aborted, a NaN met, or a task of Parallel failed.
-  bool Stopped() const { return this->AbortFlag || this->Failed || this->Interrupted; }
+  bool Stopped() const
+  {
+    return this->AbortFlag.load(std::memory_order_relaxed) ||
+      this->Failed.load(std::memory_order_relaxed) ||
+      this->Interrupted.load(std::memory_order_relaxed);
+  }
   /// True when a gradient needed a sample beyond this piece that lies inside the volume (the
   /// input lacked its ghost layer); such normals are one-sided.
   bool MissingGhosts() const { return this->GhostsMissing; }
@@ -534,7 +539,7 @@ public:
   }
 
   /// Reads the 8 corners of cube (i, j, k); false when a sample is NaN.
-  bool Evaluate(int i, int j, int k, CubeSamples& st)
+  RGMC_INLINE bool Evaluate(int i, int j, int k, CubeSamples& st)
   {
     const std::int64_t base = this->GridOf.LocalIndex(i, j, k);
     int code = 0;
@@ -557,7 +562,7 @@ public:
   }
 
   /// The surface nodes of cube (i, j, k) with samples `st`.
-  void Describe(int i, int j, int k, const CubeSamples& st, CubeSurface& surface) const
+  RGMC_INLINE void Describe(int i, int j, int k, const CubeSamples& st, CubeSurface& surface) const
   {
     surface.Set(this->Table, this->GridOf, this->Isovalue, i, j, k, st);
   }
@@ -634,7 +639,7 @@ public:
   }
 
   /// Whether a cube that contains this vertex lies in the volume but not in this rank's cubes.
-  bool IsPort(const int p[3], int axis) const
+  RGMC_INLINE bool IsPort(const int p[3], int axis) const
   {
     if (this->Owned.Overlaps().empty() && p[0] >= this->InnerLo[0] && p[0] <= this->InnerHi[0] &&
       p[1] >= this->InnerLo[1] && p[1] <= this->InnerHi[1] && p[2] >= this->InnerLo[2] &&
@@ -666,7 +671,7 @@ private:
 
   /// Negative gradient at a grid point by central differences, one-sided on the volume's
   /// border, as vtkMarchingCubes computes it.
-  void Gradient(int i, int j, int k, double n[3])
+  RGMC_INLINE void Gradient(int i, int j, int k, double n[3])
   {
     const Grid& g = this->GridOf;
     if (i >= this->CentralLo[0] && i <= this->CentralHi[0] && j >= this->CentralLo[1] &&
@@ -723,7 +728,7 @@ private:
     }
   }
 
-  void FinishNormal(const double n[3], float out[3]) const
+  RGMC_INLINE void FinishNormal(const double n[3], float out[3]) const
   {
     const auto& m = this->Options.NormalToWorld;
     double w[3];

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -207,6 +209,7 @@ public:
         });
       this->Volume.Report(0.5 + 0.45 * (c + batch) / numChunks);
     }
+    this->Pool.clear();
     if (this->Volume.Stopped())
     {
       return;
@@ -257,23 +260,56 @@ private:
     std::vector<std::int32_t> FinalId;
   };
 
-  /// The state of one chunk's extraction (one task).
+  /// The state of one chunk's extraction (one task). Its edge layers are plane-sized: they are
+  /// kept, all zero again, for the next chunk (a pool), rather than paged in anew every time.
   struct ChunkWork
   {
-    Chunk* Out;
+    Chunk* Out = nullptr;
     EdgeLayer Layers[5];
     EdgeLayer* SlabLayers[2][2] = { { nullptr, nullptr }, { nullptr, nullptr } };
     EdgeLayer* VerticalLayer = nullptr;
     int SlabK = 0;
-    KeyMap PointVertices{ 64 };
+    std::unique_ptr<KeyMap> PointVertices;
   };
+
+  std::unique_ptr<ChunkWork> TakeWork()
+  {
+    {
+      std::lock_guard<std::mutex> lock(this->PoolMutex);
+      if (!this->Pool.empty())
+      {
+        std::unique_ptr<ChunkWork> work = std::move(this->Pool.back());
+        this->Pool.pop_back();
+        return work;
+      }
+    }
+    std::unique_ptr<ChunkWork> work(new ChunkWork);
+    for (auto& layer : work->Layers)
+    {
+      layer.Ids.Allocate(this->PlaneSize);
+    }
+    return work;
+  }
+
+  void GiveBack(std::unique_ptr<ChunkWork> work)
+  {
+    for (auto& layer : work->Layers)
+    {
+      layer.Reset();
+    }
+    work->PointVertices.reset();
+    std::lock_guard<std::mutex> lock(this->PoolMutex);
+    this->Pool.push_back(std::move(work));
+  }
 
   void ExtractChunk(const std::vector<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
     int first, int last, std::int64_t triangles, Chunk& chunk)
   {
     const CellBox& box = this->NodeBox;
-    ChunkWork work;
+    std::unique_ptr<ChunkWork> taken = this->TakeWork();
+    ChunkWork& work = *taken;
     work.Out = &chunk;
+    work.PointVertices.reset(new KeyMap(64));
     chunk.LowK = box.Lo[2] + first;
     chunk.TopK = box.Lo[2] + last; // the plane above the last slab
     // A node emits at most its case's triangles; a closed surface has about half as many
@@ -298,10 +334,6 @@ private:
     }
     // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,
     // z edges inside it. The top plane becomes the next slab's bottom.
-    for (auto& layer : work.Layers)
-    {
-      layer.Ids.Allocate(this->PlaneSize);
-    }
     EdgeLayer* bottom[2] = { &work.Layers[0], &work.Layers[1] }; // x, y edges at z = k
     EdgeLayer* top[2] = { &work.Layers[2], &work.Layers[3] };    // x, y edges at z = k + 1
     EdgeLayer* vertical = &work.Layers[4];                       // z edges
@@ -331,6 +363,7 @@ private:
       std::swap(bottom[0], top[0]);
       std::swap(bottom[1], top[1]);
     }
+    this->GiveBack(std::move(taken));
     std::sort(chunk.Joins.begin(), chunk.Joins.end());
     chunk.Joins.erase(std::unique(chunk.Joins.begin(), chunk.Joins.end()), chunk.Joins.end());
   }
@@ -382,8 +415,8 @@ private:
 
   /// The output point of a vertex met by component `comp`, whose id + 1 is kept in `slot` (0:
   /// none yet): made on first use; met again by another component, the two are to be joined.
-  std::int32_t UseVertex(ChunkWork& work, std::int32_t& slot, const SurfaceVertex& v, double sLo,
-    double sHi, int comp, EdgeLayer* layer, std::int32_t index)
+  RGMC_INLINE std::int32_t UseVertex(ChunkWork& work, std::int32_t& slot, const SurfaceVertex& v,
+    double sLo, double sHi, int comp, EdgeLayer* layer, std::int32_t index)
   {
     if (slot > 0)
     {
@@ -405,13 +438,13 @@ private:
 
   /// The output point of a vertex of the current node's cube: on an edge (kept in the slab's
   /// edge layers) or on a grid point (kept in a map).
-  std::int32_t Vertex(
+  RGMC_INLINE std::int32_t Vertex(
     ChunkWork& work, const SurfaceNode& n, const SurfaceVertex& v, const CubeSamples& st)
   {
     if (v.Axis < 0)
     {
       bool inserted;
-      std::int32_t& slot = work.PointVertices.FindOrInsert(v.Key, 0, inserted);
+      std::int32_t& slot = work.PointVertices->FindOrInsert(v.Key, 0, inserted);
       return this->UseVertex(work, slot, v, 0.0, 0.0, n.Component, nullptr, 0);
     }
     const CellBox& box = this->NodeBox;
@@ -612,6 +645,8 @@ private:
   std::size_t PlaneSize = 0;
   CellBox NodeBox; // the cubes of the nodes
   std::int64_t JoinCount = 0;
+  std::mutex PoolMutex;
+  std::vector<std::unique_ptr<ChunkWork>> Pool; // chunk states not in use
 };
 
 } // namespace rgmc

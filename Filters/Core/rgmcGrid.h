@@ -3,6 +3,8 @@
 #ifndef rgmcGrid_h
 #define rgmcGrid_h
 
+#include "rgmcInline.h"
+
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -17,14 +19,15 @@ struct CellBox
   int Hi[3] = { -1, -1, -1 };
 
   bool Empty() const { return Lo[0] > Hi[0] || Lo[1] > Hi[1] || Lo[2] > Hi[2]; }
-  bool Contains(int i, int j, int k) const
+  RGMC_INLINE bool Contains(int i, int j, int k) const
   {
     return i >= Lo[0] && i <= Hi[0] && j >= Lo[1] && j <= Hi[1] && k >= Lo[2] && k <= Hi[2];
   }
   std::int64_t Count() const
   {
-    return this->Empty() ? 0
-                         : std::int64_t(Hi[0] - Lo[0] + 1) * (Hi[1] - Lo[1] + 1) * (Hi[2] - Lo[2] + 1);
+    return this->Empty()
+      ? 0
+      : std::int64_t(Hi[0] - Lo[0] + 1) * (Hi[1] - Lo[1] + 1) * (Hi[2] - Lo[2] + 1);
   }
   CellBox Intersect(const CellBox& o) const
   {
@@ -48,7 +51,8 @@ struct CellBox
   }
   bool ContainsBox(const CellBox& o) const
   {
-    return o.Empty() || (Contains(o.Lo[0], o.Lo[1], o.Lo[2]) && Contains(o.Hi[0], o.Hi[1], o.Hi[2]));
+    return o.Empty() ||
+      (Contains(o.Lo[0], o.Lo[1], o.Lo[2]) && Contains(o.Hi[0], o.Hi[1], o.Hi[2]));
   }
 };
 
@@ -243,7 +247,7 @@ public:
   int NumberOfRanks() const { return static_cast<int>(this->Boxes.size()); }
   const CellBox& BoxOf(int rank) const { return this->Boxes[rank]; }
 
-  bool Owns(int i, int j, int k) const
+  RGMC_INLINE bool Owns(int i, int j, int k) const
   {
     if (!this->Mine().Contains(i, j, k))
     {

@@ -173,7 +173,7 @@ private:
   static constexpr int TileCubes = 32;  // cubes along each axis of a tile
   static constexpr int TileWords = 512; // 64-bit words of found-bits in a tile
 
-  std::int64_t TileOf(int i, int j, int k) const
+  RGMC_INLINE std::int64_t TileOf(int i, int j, int k) const
   {
     const CellBox& b = this->Volume.Owned.Mine();
     return ((i - b.Lo[0]) >> 5) +
@@ -181,7 +181,7 @@ private:
   }
 
   /// The found-bit of an owned cube: tile, then word (4^3 cubes) in the tile, then cube.
-  std::int64_t CubeBit(int i, int j, int k) const
+  RGMC_INLINE std::int64_t CubeBit(int i, int j, int k) const
   {
     const CellBox& b = this->Volume.Owned.Mine();
     const int x = i - b.Lo[0], y = j - b.Lo[1], z = k - b.Lo[2];
@@ -190,10 +190,13 @@ private:
     return (this->TileOf(i, j, k) * TileWords + word) * 64 + bit;
   }
 
-  bool AllFound(std::int64_t bit) const { return (this->Visited[bit >> 6] >> (bit & 63)) & 1u; }
+  RGMC_INLINE bool AllFound(std::int64_t bit) const
+  {
+    return (this->Visited[bit >> 6] >> (bit & 63)) & 1u;
+  }
   void SetAllFound(std::int64_t bit) { this->Visited[bit >> 6] |= std::uint64_t(1) << (bit & 63); }
 
-  bool NodeFound(TileWork& w, std::int64_t bit, int node, int numNodes) const
+  RGMC_INLINE bool NodeFound(TileWork& w, std::int64_t bit, int node, int numNodes) const
   {
     if (this->AllFound(bit))
     {
@@ -240,7 +243,8 @@ private:
 
   /// Records the nodes of owned cube (i, j, k) that use vertex `key` (on the cube's edge
   /// `edge`; -1 for a grid-point key). `seen` is set when such a node was found before.
-  void Visit(TileWork& w, int i, int j, int k, std::int64_t key, int edge, int comp, bool* seen)
+  RGMC_INLINE void Visit(
+    TileWork& w, int i, int j, int k, std::int64_t key, int edge, int comp, bool* seen)
   {
     const std::int64_t bit = this->CubeBit(i, j, k);
     if (this->AllFound(bit) && !seen)
@@ -395,7 +399,11 @@ private:
         TileWork& w = this->Work[tile];
         this->Found.insert(this->Found.end(), w.Queue.begin(), w.Queue.end());
         this->NodesExpanded += static_cast<std::int64_t>(w.Queue.size());
-        std::vector<SurfaceNode>().swap(w.Queue); // its memory too: Found holds the nodes now
+        if (w.Queue.capacity() > 4096)
+        {
+          std::vector<SurfaceNode>().swap(w.Queue); // Found holds the nodes now
+        }
+        w.Queue.clear();
         for (const Crossing& c : w.Outbox)
         {
           const std::int64_t to = this->TileOf(c.I, c.J, c.K);
