@@ -691,16 +691,70 @@ public:
             // (each block's rows kept apart), then taken block by block in order, the others
             // going through the general path there: the same rows, in the same order, for any
             // number of threads.
+            // Whether vertex v (no other rank holds it) is inside a manifold piece; if so, its
+            // edges are counted in `edges` and its row appended to `row` (when stencils are
+            // made). Reads only: threads may call it at once.
+            auto manifoldRow = [&](vtkIdType v, std::vector<std::pair<vtkIdType, vtkIdType>>& at,
+                                 std::vector<std::int64_t>& row, vtkIdType& edges)
+            {
+              endsAt(v, at);
+              bool manifold = !at.empty() && at.size() < 2 * 255;
+              for (std::size_t e = 0; e < at.size() && manifold; e += 2)
+              {
+                manifold = e + 1 < at.size() && at[e + 1].first == at[e].first &&
+                  (e + 2 == at.size() || at[e + 2].first != at[e].first);
+              }
+              if (!manifold)
+              {
+                return false;
+              }
+              for (std::size_t e = 0; e < at.size(); e += 2)
+              {
+                edges += at[e].first > gid[v];
+                if (stencils)
+                {
+                  row.push_back(at[e].second);
+                }
+              }
+              return true;
+            };
+            auto ownRow = [&](vtkIdType v)
+            {
+              this->Owned.push_back(v);
+              this->Stencil.Offsets.push_back(
+                static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+            };
+            if (vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
+            {
+              // One thread: straight into the stencils.
+              for (vtkIdType v = 0; v < this->N; ++v)
+              {
+                if (this->Num.Holding[v] != Numbering::Alone)
+                {
+                  continue;
+                }
+                if (!manifoldRow(v, ends, this->Stencil.Neighbours, checks.Edges))
+                {
+                  general(v, false, 0);
+                }
+                else if (stencils)
+                {
+                  ownRow(v);
+                }
+              }
+            }
             struct Block
             {
               std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex of the general path
-              std::vector<vtkIdType> Offsets;  // row starts in Neighbours, per manifold vertex
-              std::vector<vtkIdType> Neighbours;
+              std::vector<vtkIdType> Ends;     // row ends in Neighbours, per manifold vertex
+              std::vector<std::int64_t> Neighbours;
               vtkIdType Edges = 0;
             };
             // Batches of blocks bound the rows held apart (memory), whatever the mesh's size.
             const vtkIdType blockSize = 4096, batchBlocks = 64;
-            const vtkIdType numBlocks = (this->N + blockSize - 1) / blockSize;
+            const vtkIdType numBlocks = vtkSMPTools::GetEstimatedNumberOfThreads() <= 1
+              ? 0
+              : (this->N + blockSize - 1) / blockSize;
             std::vector<Block> blocks;
             for (vtkIdType batch = 0; batch < numBlocks; batch += batchBlocks)
             {
@@ -720,29 +774,12 @@ public:
                       {
                         continue;
                       }
-                      endsAt(v, blockEnds);
-                      bool manifold = !blockEnds.empty() && blockEnds.size() < 2 * 255;
-                      for (std::size_t e = 0; e < blockEnds.size() && manifold; e += 2)
+                      const bool manifold =
+                        manifoldRow(v, blockEnds, block.Neighbours, block.Edges);
+                      block.Vertices.push_back(manifold ? v : -1 - v);
+                      if (manifold)
                       {
-                        manifold = e + 1 < blockEnds.size() &&
-                          blockEnds[e + 1].first == blockEnds[e].first &&
-                          (e + 2 == blockEnds.size() ||
-                            blockEnds[e + 2].first != blockEnds[e].first);
-                      }
-                      if (!manifold)
-                      {
-                        block.Vertices.push_back(-1 - v);
-                        continue;
-                      }
-                      block.Vertices.push_back(v);
-                      block.Offsets.push_back(static_cast<vtkIdType>(block.Neighbours.size()));
-                      for (std::size_t e = 0; e < blockEnds.size(); e += 2)
-                      {
-                        block.Edges += blockEnds[e].first > gid[v];
-                        if (stencils)
-                        {
-                          block.Neighbours.push_back(blockEnds[e].second);
-                        }
+                        block.Ends.push_back(static_cast<vtkIdType>(block.Neighbours.size()));
                       }
                     }
                   }
@@ -751,6 +788,7 @@ public:
               {
                 checks.Edges += block.Edges;
                 std::size_t row = 0;
+                vtkIdType begin = 0;
                 for (const vtkIdType entry : block.Vertices)
                 {
                   if (entry < 0)
@@ -758,19 +796,14 @@ public:
                     general(-1 - entry, false, 0);
                     continue;
                   }
+                  const vtkIdType end = block.Ends[row++];
                   if (stencils)
                   {
-                    this->Owned.push_back(entry);
-                    const vtkIdType begin = block.Offsets[row];
-                    const vtkIdType end = row + 1 < block.Offsets.size()
-                      ? block.Offsets[row + 1]
-                      : static_cast<vtkIdType>(block.Neighbours.size());
                     this->Stencil.Neighbours.insert(this->Stencil.Neighbours.end(),
                       block.Neighbours.begin() + begin, block.Neighbours.begin() + end);
-                    this->Stencil.Offsets.push_back(
-                      static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+                    ownRow(entry);
                   }
-                  ++row;
+                  begin = end;
                 }
                 block = Block();
               }

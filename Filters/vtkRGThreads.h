@@ -61,7 +61,8 @@ void ParallelSort(std::vector<T>& values)
 {
   const std::size_t n = values.size();
   const std::size_t slice = std::max<std::size_t>(4096, (n + 63) / 64);
-  if (n <= slice)
+  // One thread: the merges would only add copies (the result is the same either way).
+  if (n <= slice || vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
   {
     std::sort(values.begin(), values.end());
     return;
