@@ -186,9 +186,6 @@ int main(int argc, char* argv[])
   // address space, rather than heap left free by an earlier stage.
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   mallopt(M_TRIM_THRESHOLD, 128 * 1024);
-  // One heap for every thread (on threads, glibc gives each its own arena, whose free space the
-  // balloon below does not fill, and a stage could then allocate without new address space).
-  mallopt(M_ARENA_MAX, 1);
   vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
   const std::string file = "TestOutOfMemory-" + std::to_string(ranks) + ".ply";
