@@ -48,6 +48,7 @@ bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> an
   {
     mine.push_back(*value);
   }
+  ++this->Collectives;
   if (this->C->AllReduce(mine.data(), reduced.data(), static_cast<vtkIdType>(mine.size()),
         vtkCommunicator::MIN_OP) != 1)
   {
@@ -70,6 +71,7 @@ bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> an
     return true;
   }
   vtkIdType length = this->Rank == first ? static_cast<vtkIdType>(message.size()) : 0;
+  this->Collectives += length > 0 ? 2 : 1;
   this->C->Broadcast(&length, 1, first);
   std::vector<char> text(static_cast<std::size_t>(length) + 1, '\0');
   if (this->Rank == first)
@@ -87,29 +89,27 @@ bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> an
 bool Ranks::Any(bool flag)
 {
   int mine = flag ? 1 : 0, any = 0;
-  this->Check(this->C->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP), "a reduction");
+  this->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP, "a reduction");
   return any != 0;
 }
 
 void Ranks::Broadcast(std::string& text, int root)
 {
   vtkIdType length = static_cast<vtkIdType>(text.size());
-  this->Check(this->C->Broadcast(&length, 1, root), "a broadcast");
+  this->BroadcastValues(&length, 1, root, "a broadcast");
   if (this->Rank != root)
   {
     text.assign(static_cast<std::size_t>(length), '\0');
   }
   if (length > 0)
   {
-    this->Check(this->C->Broadcast(&text[0], length, root), "a broadcast");
+    this->BroadcastValues(&text[0], length, root, "a broadcast");
   }
 }
 
-template <typename T>
-std::vector<std::vector<T>> Ranks::ExchangeAny(
-  const std::vector<std::vector<T>>& outgoing, const std::vector<bool>& partners, int tag)
+std::vector<int> Ranks::TournamentOrder(const std::vector<bool>& partners) const
 {
-  std::vector<std::vector<T>> incoming(this->Size);
+  std::vector<int> order;
   const int n = this->Size + (this->Size % 2);
   const int m = n - 1;
   const int me = this->Rank;
@@ -128,16 +128,31 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
     {
       partner = ((2 * round - me) % m + m) % m;
     }
-    if (partner >= this->Size || partner == me || !partners[partner])
+    if (partner < this->Size && partner != me && partners[partner])
     {
-      continue;
+      order.push_back(partner);
     }
+  }
+  return order;
+}
+
+template <typename T>
+std::vector<std::vector<T>> Ranks::ExchangeAny(
+  const std::vector<std::vector<T>>& outgoing, const std::vector<int>& order, int tag)
+{
+  std::vector<std::vector<T>> incoming(this->Size);
+  const int me = this->Rank;
+  for (const int partner : order)
+  {
     auto send = [&]()
     {
       const vtkIdType count = static_cast<vtkIdType>(outgoing[partner].size());
       this->Check(this->C->Send(&count, 1, partner, tag), "sending a message's size");
+      ++this->Messages;
+      this->ValuesSent += count;
       for (vtkIdType at = 0; at < count; at += MaxChunk)
       {
+        ++this->Messages;
         this->Check(this->C->Send(outgoing[partner].data() + at, std::min(MaxChunk, count - at),
                       partner, tag + 1),
           "sending a message");
@@ -193,13 +208,19 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
 std::vector<std::vector<vtkIdType>> Ranks::Exchange(
   const std::vector<std::vector<vtkIdType>>& outgoing, const std::vector<bool>& partners, int tag)
 {
-  return this->ExchangeAny(outgoing, partners, tag);
+  return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag);
 }
 
 std::vector<std::vector<double>> Ranks::Exchange(
   const std::vector<std::vector<double>>& outgoing, const std::vector<bool>& partners, int tag)
 {
-  return this->ExchangeAny(outgoing, partners, tag);
+  return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag);
+}
+
+std::vector<std::vector<vtkIdType>> Ranks::ExchangeInOrder(
+  const std::vector<std::vector<vtkIdType>>& outgoing, const std::vector<int>& order, int tag)
+{
+  return this->ExchangeAny(outgoing, order, tag);
 }
 
 } // namespace rgmc

@@ -8,6 +8,7 @@
 #include "vtkMultiProcessController.h"
 #include "vtkType.h"
 
+#include <cstdint>
 #include <initializer_list>
 #include <new>
 #include <stdexcept>
@@ -81,18 +82,67 @@ public:
   std::vector<std::vector<double>> Exchange(
     const std::vector<std::vector<double>>& outgoing, const std::vector<bool>& partners, int tag);
 
+  /// Exchange with the ranks of `order` only, one after the other in that order, which the
+  /// ranks must have agreed to be deadlock-free (rgmc::Ownership::MeetingOrder): messages go to
+  /// neighbours only, and the number of steps does not depend on the number of ranks.
+  std::vector<std::vector<vtkIdType>> ExchangeInOrder(
+    const std::vector<std::vector<vtkIdType>>& outgoing, const std::vector<int>& order, int tag);
+
+  /// The controller's collectives, with the status checked (see Check) and counted.
+  template <typename T>
+  void AllReduce(const T* mine, T* reduced, vtkIdType n, int op, const char* what)
+  {
+    ++this->Collectives;
+    this->Check(this->C->AllReduce(mine, reduced, n, op), what);
+  }
+  template <typename T>
+  void AllGather(const T* mine, T* all, vtkIdType n, const char* what)
+  {
+    ++this->Collectives;
+    this->Check(this->C->AllGather(mine, all, n), what);
+  }
+  template <typename T>
+  void BroadcastValues(T* values, vtkIdType n, int root, const char* what)
+  {
+    ++this->Collectives;
+    this->Check(this->C->Broadcast(values, n, root), what);
+  }
+  template <typename T>
+  void GatherV(const T* mine, T* all, vtkIdType n, vtkIdType* lengths, vtkIdType* offsets, int root,
+    const char* what)
+  {
+    ++this->Collectives;
+    this->Check(this->C->GatherV(mine, all, n, lengths, offsets, root), what);
+  }
+  template <typename T>
+  void ScatterV(const T* all, T* mine, vtkIdType* lengths, vtkIdType* offsets, vtkIdType n,
+    int root, const char* what)
+  {
+    ++this->Collectives;
+    this->Check(this->C->ScatterV(all, mine, lengths, offsets, n, root), what);
+  }
+
   vtkMultiProcessController* C;
   const int Rank;
   const int Size;
+
+  /// What this rank has done since it was made: collective calls, and point-to-point messages
+  /// it sent (a message's size counts as one) with the values they carried.
+  std::int64_t Collectives = 0;
+  std::int64_t Messages = 0;
+  std::int64_t ValuesSent = 0;
 
   static constexpr vtkIdType MaxChunk = vtkIdType(1) << 20;
 
 private:
   std::string Failure; // the first failed communication since the last agreement
 
+  /// The partners of `partners` in the order of a round-robin tournament over all ranks.
+  std::vector<int> TournamentOrder(const std::vector<bool>& partners) const;
+
   template <typename T>
   std::vector<std::vector<T>> ExchangeAny(
-    const std::vector<std::vector<T>>& outgoing, const std::vector<bool>& partners, int tag);
+    const std::vector<std::vector<T>>& outgoing, const std::vector<int>& order, int tag);
 };
 
 } // namespace rgmc

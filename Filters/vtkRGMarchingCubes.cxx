@@ -23,6 +23,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkLogger.h"
 #include "vtkMarchingCubesTriangleCases.h"
 #include "vtkMath.h"
 #include "vtkMatrix3x3.h"
@@ -43,6 +44,7 @@
 #include <cstdlib>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numeric>
 #include <sstream>
@@ -57,6 +59,7 @@ namespace
 
 using rgmc::Ranks;
 constexpr int PortTag = 48731;
+constexpr int DepartureTag = 48741;
 
 const rgmc::CaseTable& Cases()
 {
@@ -264,6 +267,11 @@ public:
   virtual std::string Error() const = 0;
   virtual bool Aborted() const = 0;
   virtual bool MissingGhosts() const = 0;
+  virtual void SetCrossRanks(bool cross) = 0;
+  virtual std::vector<rgmc::Departure> TakeDepartures() = 0;
+  virtual void GrowFromArrivals(const std::vector<rgmc::Arrival>& arrivals, int numLabels) = 0;
+  virtual std::int64_t CubesExamined() const = 0;
+  virtual std::int64_t PlanePointsRead() const = 0;
 };
 
 template <typename Range>
@@ -291,6 +299,14 @@ public:
   std::string Error() const override { return this->Kernel.Error(); }
   bool Aborted() const override { return this->Kernel.Aborted(); }
   bool MissingGhosts() const override { return this->Kernel.MissingGhosts(); }
+  void SetCrossRanks(bool cross) override { this->Kernel.SetCrossRanks(cross); }
+  std::vector<rgmc::Departure> TakeDepartures() override { return this->Kernel.TakeDepartures(); }
+  void GrowFromArrivals(const std::vector<rgmc::Arrival>& arrivals, int numLabels) override
+  {
+    this->Kernel.GrowFromArrivals(arrivals, numLabels);
+  }
+  std::int64_t CubesExamined() const override { return this->Kernel.CubesExamined(); }
+  std::int64_t PlanePointsRead() const override { return this->Kernel.PlanePointsRead(); }
 
 private:
   Range Values;
@@ -318,6 +334,34 @@ struct MakeKernel
       vtk::DataArrayValueRange<1>(array), *this->Grid, *this->Own, *this->Options));
   }
 };
+
+// ---- routing between neighbours ------------------------------------------------------------
+
+/// Calls `to(owner)` once for each other rank that owns a cube around vertex `key` (one of this
+/// rank's vertices: such cubes touch this rank's, so their owners are among its neighbours).
+template <typename To>
+void ForOtherOwners(
+  const rgmc::Grid& grid, const rgmc::Ownership& own, int rank, std::int64_t key, To&& to)
+{
+  int p[3], axis;
+  grid.Decode(key, p, axis);
+  int sentTo[8], numSent = 0;
+  rgmc::ForCubesAround(p, axis,
+    [&](int i, int j, int k, int)
+    {
+      if (!grid.HasCell(i, j, k) || own.Owns(i, j, k))
+      {
+        return;
+      }
+      const int owner = own.OwnerNear(i, j, k);
+      if (owner < 0 || owner == rank || std::count(sentTo, sentTo + numSent, owner))
+      {
+        return;
+      }
+      sentTo[numSent++] = owner;
+      to(owner);
+    });
+}
 
 // ---- the global decision: which components to keep, and their ids --------------------------
 
@@ -358,7 +402,7 @@ bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc
 
   vtkIdType localCount = static_cast<vtkIdType>(roots.size());
   std::vector<vtkIdType> counts(ranks.Size), offsets(ranks.Size + 1, 0);
-  ranks.Check(ranks.C->AllGather(&localCount, counts.data(), 1), "gathering component counts");
+  ranks.AllGather(&localCount, counts.data(), 1, "gathering component counts");
   for (int r = 0; r < ranks.Size; ++r)
   {
     offsets[r + 1] = offsets[r] + counts[r];
@@ -375,22 +419,9 @@ bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc
           {
             const vtkIdType gid = myOffset + rootIndex[port.Component];
             mine.emplace_back(port.Key, gid);
-            int p[3], axis;
-            grid.Decode(port.Key, p, axis);
-            int sentTo[8], numSent = 0;
-            rgmc::ForCubesAround(p, axis,
-              [&](int i, int j, int k, int)
+            ForOtherOwners(grid, own, ranks.Rank, port.Key,
+              [&](int owner)
               {
-                if (!grid.HasCell(i, j, k) || own.Owns(i, j, k))
-                {
-                  return;
-                }
-                const int owner = own.Owner(i, j, k);
-                if (owner < 0 || owner == ranks.Rank || std::count(sentTo, sentTo + numSent, owner))
-                {
-                  return;
-                }
-                sentTo[numSent++] = owner;
                 outgoing[owner].push_back(port.Key);
                 outgoing[owner].push_back(gid);
               });
@@ -399,14 +430,8 @@ bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc
   {
     return false;
   }
-  std::vector<bool> partners(ranks.Size, false);
-  const rgmc::CellBox near = own.Mine().Grown(1);
-  for (int r = 0; r < ranks.Size; ++r)
-  {
-    partners[r] = r != ranks.Rank && !own.Mine().Empty() && !own.BoxOf(r).Empty() &&
-      !near.Intersect(own.BoxOf(r)).Empty();
-  }
-  const std::vector<std::vector<vtkIdType>> incoming = ranks.Exchange(outgoing, partners, PortTag);
+  const std::vector<std::vector<vtkIdType>> incoming =
+    ranks.ExchangeInOrder(outgoing, own.MeetingOrder(), PortTag);
 
   // Edges of the component graph: my component and theirs share a vertex.
   const vtkIdType total = offsets[ranks.Size];
@@ -458,13 +483,12 @@ bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc
   {
     return false;
   }
-  ranks.Check(ranks.C->GatherV(info.data(), allInfo.data(), static_cast<vtkIdType>(info.size()),
-                infoLengths.data(), infoOffsets.data(), 0),
-    "gathering the components");
+  ranks.GatherV(info.data(), allInfo.data(), static_cast<vtkIdType>(info.size()),
+    infoLengths.data(), infoOffsets.data(), 0, "gathering the components");
   vtkIdType edgeLength = static_cast<vtkIdType>(flatEdges.size());
   std::vector<vtkIdType> edgeLengths(ranks.Size), edgeOffsets(ranks.Size + 1, 0);
   // Every rank learns every length: VTK 9.5's GatherV reads the lengths and offsets on all ranks.
-  ranks.Check(ranks.C->AllGather(&edgeLength, edgeLengths.data(), 1), "gathering edge counts");
+  ranks.AllGather(&edgeLength, edgeLengths.data(), 1, "gathering edge counts");
   for (int r = 0; r < ranks.Size; ++r)
   {
     edgeOffsets[r + 1] = edgeOffsets[r] + edgeLengths[r];
@@ -475,9 +499,8 @@ bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc
   {
     return false;
   }
-  ranks.Check(ranks.C->GatherV(flatEdges.data(), allEdges.data(), edgeLength, edgeLengths.data(),
-                edgeOffsets.data(), 0),
-    "gathering the component graph");
+  ranks.GatherV(flatEdges.data(), allEdges.data(), edgeLength, edgeLengths.data(),
+    edgeOffsets.data(), 0, "gathering the component graph");
 
   vtkIdType totals[2] = { 0, 0 };
   if (!ranks.Step("decide which components to keep", problem,
@@ -551,11 +574,10 @@ bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc
   {
     return false;
   }
-  ranks.Check(ranks.C->ScatterV(finalIds.data(), decision.FinalId.data(), counts.data(),
-                offsets.data(), localCount, 0),
-    "scattering the decision");
+  ranks.ScatterV(finalIds.data(), decision.FinalId.data(), counts.data(), offsets.data(),
+    localCount, 0, "scattering the decision");
   decision.FinalId.resize(static_cast<std::size_t>(localCount));
-  ranks.Check(ranks.C->Broadcast(totals, 2, 0), "broadcasting the totals");
+  ranks.BroadcastValues(totals, 2, 0, "broadcasting the totals");
   decision.Triangles = totals[0];
   decision.Components = totals[1];
   // Component ids are 32-bit in the output (ComponentId, like vtkConnectivityFilter's RegionId).
@@ -578,8 +600,8 @@ void GlobalRange(Ranks& ranks, vtkDataArray* scalars, double range[2])
     lo = r[0];
     hi = r[1];
   }
-  ranks.Check(ranks.C->AllReduce(&lo, &range[0], 1, vtkCommunicator::MIN_OP), "a reduction");
-  ranks.Check(ranks.C->AllReduce(&hi, &range[1], 1, vtkCommunicator::MAX_OP), "a reduction");
+  ranks.AllReduce(&lo, &range[0], 1, vtkCommunicator::MIN_OP, "a reduction");
+  ranks.AllReduce(&hi, &range[1], 1, vtkCommunicator::MAX_OP, "a reduction");
 }
 
 } // namespace
@@ -670,6 +692,9 @@ struct vtkRGMarchingCubes::Run
   std::vector<double> seedPoints;
   std::vector<int> rootIndex;
   Decision decision;
+  int rounds = 0;       // rounds of growth between ranks
+  bool oneStep = false; // the rest grown in one step (GrowBoundary) or a full scan
+  vtkIdType trianglesMade = 0;
 };
 
 //------------------------------------------------------------------------------
@@ -698,6 +723,13 @@ int vtkRGMarchingCubes::RequestData(
   this->AbortExecute = 0;
   vtkNew<vtkDummyController> single;
   Run run(this->Controller ? this->Controller : single.Get());
+  // The counts of this run, however it ends.
+  struct Accounting
+  {
+    vtkRGMarchingCubes* Filter;
+    Run& Counted;
+    ~Accounting() { this->Filter->Account(this->Counted); }
+  } accounting{ this, run };
 
   // PASS 0: check the input on every rank and agree on the verdict.
   if (!this->CheckInput(run, input, inputVector))
@@ -781,7 +813,7 @@ bool vtkRGMarchingCubes::CheckInput(
         }
       }
     }
-    ranks.Check(ranks.C->AllReduce(mine, agreed, 6, vtkCommunicator::MIN_OP), "a reduction");
+    ranks.AllReduce(mine, agreed, 6, vtkCommunicator::MIN_OP, "a reduction");
     if (agreed[0] <= -agreed[3])
     {
       for (int a = 0; a < 3; ++a)
@@ -880,7 +912,7 @@ bool vtkRGMarchingCubes::CheckInput(
     const double* d = input->GetDirectionMatrix()->GetData();
     std::copy_n(d, 9, g + 6);
   }
-  ranks.Check(ranks.C->Broadcast(g, 15, source), "a broadcast");
+  ranks.BroadcastValues(g, 15, source, "a broadcast");
   std::copy_n(g, 3, run.geometry.Origin);
   std::copy_n(g + 3, 3, run.geometry.Spacing);
   std::copy_n(g + 6, 9, run.geometry.Direction);
@@ -911,7 +943,7 @@ void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
     const int mine[12] = { myCells.Lo[0], myCells.Lo[1], myCells.Lo[2], myCells.Hi[0],
       myCells.Hi[1], myCells.Hi[2], allMine.Lo[0], allMine.Lo[1], allMine.Lo[2], allMine.Hi[0],
       allMine.Hi[1], allMine.Hi[2] };
-    ranks.Check(ranks.C->AllGather(mine, boxes.data(), 12), "a gather");
+    ranks.AllGather(mine, boxes.data(), 12, "a gather");
   }
   std::vector<rgmc::CellBox> cellBoxes(ranks.Size), extentBoxes(ranks.Size);
   for (int r = 0; r < ranks.Size; ++r)
@@ -1050,8 +1082,7 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
   {
     d2[s] = hits[s].Distance2;
   }
-  ranks.Check(
-    ranks.C->AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP), "a reduction");
+  ranks.AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP, "a reduction");
   std::vector<vtkIdType> keys(numSeeds), bestKeys(numSeeds);
   for (int s = 0; s < numSeeds; ++s)
   {
@@ -1059,8 +1090,7 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
       ? hits[s].Key
       : std::numeric_limits<vtkIdType>::max();
   }
-  ranks.Check(ranks.C->AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP),
-    "a reduction");
+  ranks.AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP, "a reduction");
   std::vector<double> points(3 * numSeeds), bestPoints(3 * numSeeds);
   for (int s = 0; s < numSeeds; ++s)
   {
@@ -1070,9 +1100,8 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
         hits[s].Found && hits[s].Key == bestKeys[s] ? hits[s].Point[a] : VTK_DOUBLE_MAX;
     }
   }
-  ranks.Check(
-    ranks.C->AllReduce(points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP),
-    "a reduction");
+  ranks.AllReduce(
+    points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP, "a reduction");
   for (int s = 0; s < numSeeds; ++s)
   {
     if (bestKeys[s] == std::numeric_limits<vtkIdType>::max())
@@ -1106,25 +1135,35 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
 {
   Ranks& ranks = run.ranks;
   AnyKernel& kernel = *run.kernel;
+  const bool rounds = this->ExtractionMode == SEEDED && ranks.Size > 1;
+  bool aborted = false;
+  if (rounds)
+  {
+    if (!this->GrowInRounds(run, aborted))
+    {
+      vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
+      return -1;
+    }
+  }
   std::string outOfMemory;
   try
   {
-    if (this->ExtractionMode == SEEDED)
+    if (!rounds && this->ExtractionMode == SEEDED)
     {
       for (vtkIdType key : run.seedKeys)
       {
-        kernel.GrowFromKey(key); // seeded components; before the boundary growth
-      }
-      if (ranks.Size > 1)
-      {
-        kernel.GrowBoundary();
+        kernel.GrowFromKey(key);
       }
     }
-    else
+    else if (!rounds)
     {
+      run.oneStep = true;
       kernel.GrowAll();
     }
-    kernel.Extract();
+    if (!aborted)
+    {
+      kernel.Extract();
+    }
   }
   catch (const std::length_error& tooMany)
   {
@@ -1137,8 +1176,10 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
       std::to_string(ranks.Rank) + " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) +
       " triangles so far)";
   }
+  run.trianglesMade = kernel.Mesh().NumberOfTriangles();
   run.problem = outOfMemory.empty() ? kernel.Error() : outOfMemory;
-  bool aborted = kernel.Aborted(), missingGhosts = kernel.MissingGhosts();
+  aborted = aborted || kernel.Aborted();
+  bool missingGhosts = kernel.MissingGhosts();
   if (!ranks.Agree(run.problem.empty(), run.problem, { &aborted, &missingGhosts }))
   {
     vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
@@ -1154,6 +1195,137 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
                        "are one-sided there and differ from a 1-rank run.");
   }
   return 1;
+}
+
+//------------------------------------------------------------------------------
+// Seeded growth on several ranks. Round 0 grows from the seed vertices on the ranks that own
+// cubes around them. Each round then: the departures (vertices where growth stepped into
+// another rank's cubes) go to those cubes' owners, once per vertex and owner, except back to
+// the rank a vertex just came from; one reduction agrees on the status and on whether anybody
+// sent anything; if so, the neighbours exchange departures and each rank grows on from what it
+// received (one new component per sending rank's component). A rank the structure never
+// reaches examines no cube. Past MaximumGrowthRounds every rank grows the rest in one step.
+bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
+{
+  Ranks& ranks = run.ranks;
+  AnyKernel& kernel = *run.kernel;
+  const rgmc::Grid& grid = *run.grid;
+  const rgmc::Ownership& own = *run.own;
+  std::string problem;
+  auto local = [&](const char* what, const std::function<void()>& work)
+  {
+    if (!problem.empty())
+    {
+      return;
+    }
+    try
+    {
+      work();
+    }
+    catch (const std::length_error& tooMany)
+    {
+      problem = std::string(tooMany.what()) + " on rank " + std::to_string(ranks.Rank) +
+        ": run on more ranks";
+    }
+    catch (const std::bad_alloc&)
+    {
+      problem =
+        std::string("not enough memory to ") + what + " on rank " + std::to_string(ranks.Rank);
+    }
+  };
+  kernel.SetCrossRanks(true);
+  local("grow from the seeds",
+    [&]()
+    {
+      for (vtkIdType key : run.seedKeys)
+      {
+        kernel.GrowFromKey(key);
+      }
+    });
+  // The vertices received last, by rank: not sent back there.
+  std::vector<std::pair<std::int64_t, int>> received;
+  for (;;)
+  {
+    std::vector<std::vector<vtkIdType>> outgoing(ranks.Size);
+    bool sending = false;
+    local("send the growing surface to the neighbours",
+      [&]()
+      {
+        std::vector<rgmc::Departure> departures = kernel.TakeDepartures();
+        std::sort(departures.begin(), departures.end(),
+          [](const rgmc::Departure& a, const rgmc::Departure& b)
+          { return a.Key < b.Key || (a.Key == b.Key && a.Component < b.Component); });
+        std::int64_t last = -1;
+        for (const rgmc::Departure& d : departures)
+        {
+          if (d.Key == last)
+          {
+            continue;
+          }
+          last = d.Key;
+          ForOtherOwners(grid, own, ranks.Rank, d.Key,
+            [&](int owner)
+            {
+              if (!std::binary_search(
+                    received.begin(), received.end(), std::make_pair(d.Key, owner)))
+              {
+                outgoing[owner].push_back(d.Key);
+                outgoing[owner].push_back(d.Component);
+                sending = true;
+              }
+            });
+        }
+      });
+    if (problem.empty())
+    {
+      problem = kernel.Error();
+    }
+    aborted = kernel.Aborted();
+    if (!ranks.Agree(problem.empty(), problem, { &sending, &aborted }))
+    {
+      run.problem = problem;
+      return false;
+    }
+    if (!sending || aborted)
+    {
+      return true;
+    }
+    if (run.rounds >= this->MaximumGrowthRounds)
+    {
+      // The rest in one step: every component next to another rank's cubes; Resolve keeps
+      // those joined to a seed. The departures not sent are among them.
+      run.oneStep = true;
+      kernel.SetCrossRanks(false);
+      local("grow the components at the shared faces", [&]() { kernel.GrowBoundary(); });
+      return true; // GrowAndExtract agrees on the status
+    }
+    const std::vector<std::vector<vtkIdType>> incoming =
+      ranks.ExchangeInOrder(outgoing, own.MeetingOrder(), DepartureTag);
+    ++run.rounds;
+    local("grow from the neighbours' surface",
+      [&]()
+      {
+        // One label per component of a sending rank, in the order of the ranks.
+        std::vector<rgmc::Arrival> arrivals;
+        std::map<vtkIdType, int> labelOf; // of the sending rank's components
+        int numLabels = 0;
+        received.clear();
+        for (const int from : own.Neighbours())
+        {
+          labelOf.clear();
+          const std::vector<vtkIdType>& list = incoming[from];
+          for (std::size_t n = 0; n + 1 < list.size(); n += 2)
+          {
+            auto label = labelOf.emplace(list[n + 1], numLabels);
+            numLabels += label.second ? 1 : 0;
+            arrivals.push_back(rgmc::Arrival{ list[n], label.first->second });
+            received.emplace_back(list[n], from);
+          }
+        }
+        std::sort(received.begin(), received.end());
+        kernel.GrowFromArrivals(arrivals, numLabels);
+      });
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -1306,6 +1478,30 @@ void vtkRGMarchingCubes::DescribeSurface(Run& run, vtkPolyData* output)
 }
 
 //------------------------------------------------------------------------------
+void vtkRGMarchingCubes::Account(Run& run)
+{
+  this->NumberOfGrowthRounds = run.rounds;
+  this->GrewInOneStep = run.oneStep;
+  this->NumberOfCollectives = static_cast<vtkIdType>(run.ranks.Collectives);
+  this->NumberOfMessages = static_cast<vtkIdType>(run.ranks.Messages);
+  this->NumberOfValuesSent = static_cast<vtkIdType>(run.ranks.ValuesSent);
+  this->NumberOfCubesExamined = run.kernel ? run.kernel->CubesExamined() : 0;
+  this->NumberOfFacePointsRead = run.kernel ? run.kernel->PlanePointsRead() : 0;
+  this->NumberOfTrianglesMade = run.trianglesMade;
+  vtkLogF(TRACE,
+    "vtkRGMarchingCubes on rank %d of %d: %d rounds of growth between ranks%s, %lld collectives, "
+    "%lld messages sent (%lld values), %lld cubes examined, %lld face points read, %lld "
+    "triangles made",
+    run.ranks.Rank, run.ranks.Size, run.rounds, run.oneStep ? " then one step" : "",
+    static_cast<long long>(this->NumberOfCollectives),
+    static_cast<long long>(this->NumberOfMessages),
+    static_cast<long long>(this->NumberOfValuesSent),
+    static_cast<long long>(this->NumberOfCubesExamined),
+    static_cast<long long>(this->NumberOfFacePointsRead),
+    static_cast<long long>(this->NumberOfTrianglesMade));
+}
+
+//------------------------------------------------------------------------------
 void vtkRGMarchingCubes::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -1320,5 +1516,6 @@ void vtkRGMarchingCubes::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ExtractionMode: " << this->ExtractionMode << "\n";
   os << indent << "ComputeNormals: " << (this->ComputeNormals ? "On" : "Off") << "\n";
   os << indent << "OutputPointsPrecision: " << this->OutputPointsPrecision << "\n";
+  os << indent << "MaximumGrowthRounds: " << this->MaximumGrowthRounds << "\n";
   os << indent << "Controller: " << this->Controller << "\n";
 }

@@ -34,19 +34,29 @@
  * Growing only from the seed's rank would make the others wait; growing from a seed per piece
  * (the paper's method) needs a manual seed per part and misses pieces of the surface.
  *
- * Approach: two-phase growth with a fixed number of collective steps.
+ * Approach (Seeded mode): growth in rounds between neighbouring ranks, so that the work follows
+ * the chosen structure. Largest and All modes must see every component anyway: they grow
+ * everywhere at once and join the pieces in one step.
  * Steps:
  * 1. Ownership: every cube belongs to exactly one rank (the lowest whose non-ghost cells
- *    contain it); owned cell boxes are gathered on all ranks.
- * 2. Seeds: each rank finds, among its cubes, the vertex nearest each seed; a reduction picks
+ *    contain it); owned cell boxes are gathered on all ranks, and each rank knows its
+ *    neighbours (ranks whose cubes touch its own) and the order in which it meets them.
+ * 2. Seeds: each rank finds, among its cubes, the vertex nearest each seed; one gather picks
  *    the global one (ties: smallest key).
- * 3. Local growth, on all ranks at once, from the seed vertices and from every surface node
- *    next to another rank's cubes, labelling local components and recording their ports
- *    (vertices shared with cubes of other ranks).
- * 4. Ports are exchanged between neighbouring ranks and matched by key; the small component
- *    graph is gathered on rank 0, joined (union-find), and each rank learns which of its
- *    components to keep and their global ids.
+ * 3. Growth. Seeded: the ranks that own cubes around a seed vertex grow from it; a step into a
+ *    cube of another rank becomes a departure (the vertex and its component), sent to that
+ *    cube's owner, which grows on from it in the next round. Rounds end when a reduction says no
+ *    rank sent anything: a rank the structure never reaches reads no cube. After
+ *    MaximumGrowthRounds rounds (a structure that crosses between ranks very often) the rest
+ *    is grown in one step instead: every rank grows every component next to another rank's
+ *    cubes, and step 4 keeps those joined to a seed. Largest and All: every rank scans all its
+ *    cubes.
+ * 4. Triangles are made; vertices shared with other ranks' cubes (ports) are exchanged with
+ *    the neighbours and matched by key; the small component graph is gathered on rank 0,
+ *    joined (union-find), and each rank learns which of its components to keep and their ids.
  * 5. Each rank outputs the triangles of its kept components: their union is the 1-rank output.
+ * Messages go only between neighbours. The counts of collectives and messages of the last run
+ * are logged at TRACE verbosity and kept (GetNumberOfCollectives and the like).
  * Every error is collective: a status is reduced before each collective step, so a failure on
  * one rank gives every rank the same message and an empty output instead of a deadlock.
  *
@@ -143,6 +153,37 @@ public:
 
   ///@{
   /**
+   * Seeded mode on several ranks: how many rounds of growth between ranks are made before the
+   * rest of the structure is grown in one step (every rank growing every component next to
+   * another rank's cubes, the unselected ones dropped afterwards). Each round costs one
+   * reduction and one message to each neighbour; a structure needs one round each time it
+   * passes from rank to rank along its longest path. The output is the same either way.
+   * Default 256; 0 grows in one step at once.
+   */
+  vtkSetClampMacro(MaximumGrowthRounds, int, 0, VTK_INT_MAX);
+  vtkGetMacro(MaximumGrowthRounds, int);
+  ///@}
+
+  ///@{
+  /**
+   * What the last run did on this rank (for tests, benchmarks and the TRACE log): rounds of
+   * growth between ranks, whether the rest was grown in one step (MaximumGrowthRounds
+   * reached, or Largest and All modes), collective calls, point-to-point messages sent and the
+   * values they carried, cubes the growth examined, grid points of shared faces read by the
+   * one-step growth, and triangles made before the selection of components.
+   */
+  vtkGetMacro(NumberOfGrowthRounds, int);
+  vtkGetMacro(GrewInOneStep, bool);
+  vtkGetMacro(NumberOfCollectives, vtkIdType);
+  vtkGetMacro(NumberOfMessages, vtkIdType);
+  vtkGetMacro(NumberOfValuesSent, vtkIdType);
+  vtkGetMacro(NumberOfCubesExamined, vtkIdType);
+  vtkGetMacro(NumberOfFacePointsRead, vtkIdType);
+  vtkGetMacro(NumberOfTrianglesMade, vtkIdType);
+  ///@}
+
+  ///@{
+  /**
    * The controller that links the ranks. Defaults to the global controller; a single process
    * without MPI runs the same code on a dummy controller.
    */
@@ -165,6 +206,16 @@ protected:
   bool ComputeNormals = true;
   int OutputPointsPrecision = SINGLE_PRECISION;
   vtkMultiProcessController* Controller = nullptr;
+  int MaximumGrowthRounds = 256;
+
+  int NumberOfGrowthRounds = 0;
+  bool GrewInOneStep = false;
+  vtkIdType NumberOfCollectives = 0;
+  vtkIdType NumberOfMessages = 0;
+  vtkIdType NumberOfValuesSent = 0;
+  vtkIdType NumberOfCubesExamined = 0;
+  vtkIdType NumberOfFacePointsRead = 0;
+  vtkIdType NumberOfTrianglesMade = 0;
 
 private:
   vtkRGMarchingCubes(const vtkRGMarchingCubes&) = delete;
@@ -179,6 +230,9 @@ private:
   int FindSeeds(Run& run);
   /// 1: done; 0: aborted; -1: an error.
   int GrowAndExtract(Run& run);
+  /// Seeded growth on several ranks, in rounds; false on an error (in the run).
+  bool GrowInRounds(Run& run, bool& aborted);
+  void Account(Run& run);
   bool StoreSurface(Run& run, vtkPolyData* output);
   void DescribeSurface(Run& run, vtkPolyData* output);
 };

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace rgmc
@@ -239,6 +240,55 @@ public:
         }
       }
     }
+    // Which ranks touch which, and a proper colouring of those pairs, greedily in the order of
+    // the pairs: the same on every rank, as every rank knows every box. A rank meets its
+    // neighbours in the order of their pairs' colours; the pending meeting of smallest colour
+    // can always go ahead (both its ranks are through the smaller colours, and no rank has two
+    // pairs of one colour), so blocking sends in that order cannot deadlock, and there are
+    // fewer steps than twice the most neighbours a rank has, whatever the number of ranks.
+    const int numRanks = static_cast<int>(this->Boxes.size());
+    std::vector<std::vector<char>> used(static_cast<std::size_t>(numRanks));
+    std::vector<std::pair<int, int>> mineByColour;
+    for (int a = 0; a < numRanks; ++a)
+    {
+      for (int b = a + 1; b < numRanks; ++b)
+      {
+        if (!Touch(this->Boxes[a], this->Boxes[b]))
+        {
+          continue;
+        }
+        std::size_t colour = 0;
+        while ((colour < used[a].size() && used[a][colour]) ||
+          (colour < used[b].size() && used[b][colour]))
+        {
+          ++colour;
+        }
+        for (const int r : { a, b })
+        {
+          used[r].resize(std::max(used[r].size(), colour + 1), 0);
+          used[r][colour] = 1;
+        }
+        if (a == rank || b == rank)
+        {
+          const int other = a == rank ? b : a;
+          this->NeighbourRanks.push_back(other);
+          mineByColour.emplace_back(static_cast<int>(colour), other);
+        }
+      }
+    }
+    std::sort(this->NeighbourRanks.begin(), this->NeighbourRanks.end());
+    std::sort(mineByColour.begin(), mineByColour.end());
+    for (const auto& m : mineByColour)
+    {
+      this->Meetings.push_back(m.second);
+    }
+  }
+
+  /// Whether two non-empty boxes of cubes share a cube, a face, an edge or a corner: then some
+  /// vertex can have cubes of both around it.
+  static bool Touch(const CellBox& a, const CellBox& b)
+  {
+    return !a.Empty() && !b.Empty() && !a.Grown(1).Intersect(b).Empty();
   }
 
   const CellBox& Mine() const { return this->Boxes[this->Rank]; }
@@ -263,23 +313,44 @@ public:
     return true;
   }
 
-  /// The owning rank of a cube, or -1 when no rank has it.
-  int Owner(int i, int j, int k) const
+  /// The ranks whose cubes touch this rank's (sorted): the only ones a vertex of this rank's
+  /// cubes can be shared with.
+  const std::vector<int>& Neighbours() const { return this->NeighbourRanks; }
+
+  /// This rank's neighbours in the order in which it exchanges messages with them (see the
+  /// constructor): for Ranks::ExchangeInOrder.
+  const std::vector<int>& MeetingOrder() const { return this->Meetings; }
+
+  /// The owning rank of a cube that touches this rank's cubes (a cube around one of its
+  /// vertices), or -1 when no rank has it. Looks at this rank and its neighbours only.
+  int OwnerNear(int i, int j, int k) const
   {
-    for (int r = 0; r < static_cast<int>(this->Boxes.size()); ++r)
+    // The lowest rank whose box contains the cube: this rank's place among its neighbours.
+    bool mineChecked = false;
+    for (const int r : this->NeighbourRanks)
     {
+      if (!mineChecked && r > this->Rank)
+      {
+        mineChecked = true;
+        if (this->Mine().Contains(i, j, k))
+        {
+          return this->Rank;
+        }
+      }
       if (this->Boxes[r].Contains(i, j, k))
       {
         return r;
       }
     }
-    return -1;
+    return !mineChecked && this->Mine().Contains(i, j, k) ? this->Rank : -1;
   }
 
 private:
   std::vector<CellBox> Boxes;
   int Rank = 0;
   std::vector<CellBox> LowerOverlaps;
+  std::vector<int> NeighbourRanks;
+  std::vector<int> Meetings;
   bool CoveredByLower = false;
 };
 

@@ -14,6 +14,11 @@
 // of threads. The full scan (All and Largest modes) searches each tile on its own, crossings
 // dropped: a component that spans tiles gets one label per tile, and extraction joins them
 // through their shared vertices, as it joins components across ranks.
+//
+// Ranks. With CrossRanks set, a step into a cube another rank owns is kept as a departure (the
+// vertex and the component that reached it); the VTK layer sends departures to the cubes'
+// owners, which grow on from them (GrowFromArrivals): the same protocol again, between ranks,
+// in rounds until no rank has anything new.
 #ifndef rgmcGrowth_h
 #define rgmcGrowth_h
 
@@ -21,12 +26,30 @@
 #include "rgmcCubeSurface.h"
 #include "rgmcKeyMap.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 namespace rgmc
 {
+
+/// A vertex that growth reached in a cube of this rank whose other cubes around it include
+/// one of another rank, with the component that reached it.
+struct Departure
+{
+  std::int64_t Key;
+  int Component;
+};
+
+/// A vertex that another rank's growth reached, to grow on from in this rank's cubes around
+/// it; Label numbers the arrivals' components from 0 (arrivals of one component of one rank
+/// share a label).
+struct Arrival
+{
+  std::int64_t Key;
+  int Label;
+};
 
 template <typename Values>
 class SurfaceGrowth
@@ -52,6 +75,75 @@ public:
 
   /// The nodes found: by round, then by tile, then in the order each tile found them.
   std::vector<SurfaceNode>& Nodes() { return this->Found; }
+
+  /// Whether steps into cubes of other ranks are kept as departures (seeded growth on several
+  /// ranks) instead of dropped.
+  bool CrossRanks = false;
+
+  /// The departures since the last call, in the order found (by round, then tile); duplicates
+  /// are possible. Leaves the list empty.
+  std::vector<Departure> TakeDepartures()
+  {
+    std::vector<Departure> taken;
+    taken.swap(this->Departures);
+    return taken;
+  }
+
+  /// How many grid points of the faces shared with other ranks GrowBoundary read.
+  std::int64_t PlanePointsRead() const { return this->PlanePoints; }
+
+  /// How many cubes growth examined (read the samples of) on this rank so far.
+  std::int64_t CubesExamined() const
+  {
+    std::int64_t total = this->ScannedCubes;
+    for (const TileWork& w : this->Work)
+    {
+      total += w.Examined;
+    }
+    return total;
+  }
+
+  /// Grows on from vertices that other ranks' growth reached: every arrival label becomes a new
+  /// seeded component (reachable from a seed), grown from the nodes of this rank's cubes that
+  /// use the arrival's vertex and were not found yet. Arrivals are taken in the order given.
+  void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels)
+  {
+    if (this->Work.empty() || arrivals.empty())
+    {
+      return;
+    }
+    const int first = this->Components.Size();
+    for (int l = 0; l < numLabels; ++l)
+    {
+      this->Components.Add(true);
+    }
+    std::vector<std::int64_t> active;
+    std::vector<char> isActive(this->Work.size(), 0);
+    for (const Arrival& a : arrivals)
+    {
+      int p[3], axis;
+      this->Volume.GridOf.Decode(a.Key, p, axis);
+      ForCubesAround(p, axis,
+        [&](int i, int j, int k, int edge)
+        {
+          if (!this->Volume.Owned.Owns(i, j, k))
+          {
+            return;
+          }
+          const std::int64_t tile = this->TileOf(i, j, k);
+          TileWork& w = this->Work[tile];
+          const std::size_t before = w.Queue.size();
+          this->Visit(w, i, j, k, a.Key, edge, first + a.Label, nullptr);
+          if (w.Queue.size() > before && !isActive[tile])
+          {
+            isActive[tile] = 1;
+            active.push_back(tile);
+          }
+        });
+    }
+    std::sort(active.begin(), active.end());
+    this->Rounds(active);
+  }
 
   /// Grows, as a new seeded component, the component that contains the vertex `key`, from the
   /// nodes of this piece that use it. Returns the new component; -1 when no cube this piece owns
@@ -167,7 +259,9 @@ private:
     std::vector<SurfaceNode> Queue;
     std::vector<Crossing> Inbox;
     std::vector<Crossing> Outbox;
+    std::vector<Departure> Departures;
     std::unique_ptr<KeyMap> FoundNodesOfCube;
+    std::int64_t Examined = 0; // cubes whose samples Visit read
   };
 
   static constexpr int TileCubes = 32;  // cubes along each axis of a tile
@@ -252,6 +346,7 @@ private:
       return;
     }
     CubeSamples st;
+    ++w.Examined;
     if (!this->Volume.Evaluate(i, j, k, st))
     {
       return;
@@ -299,9 +394,18 @@ private:
         ForCubesAround(v.Point, v.Axis,
           [&](int i, int j, int k, int edge)
           {
-            if ((i == n.I && j == n.J && k == n.K) || !own.Owns(i, j, k))
+            if (i == n.I && j == n.J && k == n.K)
             {
-              return; // owned cubes lie inside the volume
+              return;
+            }
+            if (!own.Owns(i, j, k))
+            {
+              // Owned cubes lie inside the volume; one of another rank is a departure.
+              if (this->CrossRanks && this->Volume.GridOf.HasCell(i, j, k))
+              {
+                w.Departures.push_back(Departure{ v.Key, n.Component });
+              }
+              return;
             }
             const std::int64_t to = this->TileOf(i, j, k);
             if (to == tile)
@@ -414,6 +518,8 @@ private:
           this->Work[to].Inbox.push_back(c);
         }
         w.Outbox = std::vector<Crossing>();
+        this->Departures.insert(this->Departures.end(), w.Departures.begin(), w.Departures.end());
+        w.Departures = std::vector<Departure>();
       }
       std::sort(next.begin(), next.end());
       active.swap(next);
@@ -433,6 +539,7 @@ private:
     const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
     int p[3];
     p[axis] = plane;
+    this->PlanePoints += std::int64_t(box.Hi[u] - box.Lo[u] + 2) * (box.Hi[v] - box.Lo[v] + 2);
     for (p[v] = box.Lo[v]; p[v] <= box.Hi[v] + 1 && !volume.Stopped(); ++p[v])
     {
       for (p[u] = box.Lo[u]; p[u] <= box.Hi[u] + 1 && !volume.Stopped(); ++p[u])
@@ -496,8 +603,12 @@ private:
             continue;
           }
           const std::int64_t bit = this->CubeBit(i, j, k);
-          if (this->AllFound(bit) || !volume.Evaluate(i, j, k, st) || st.Case == 0 ||
-            st.Case == 255)
+          if (this->AllFound(bit))
+          {
+            continue;
+          }
+          ++w.Examined;
+          if (!volume.Evaluate(i, j, k, st) || st.Case == 0 || st.Case == 255)
           {
             continue;
           }
@@ -536,8 +647,12 @@ private:
             continue;
           }
           const std::int64_t bit = this->CubeBit(i, j, k);
-          if (this->AllFound(bit) || !volume.Evaluate(i, j, k, st) || st.Case == 0 ||
-            st.Case == 255)
+          if (this->AllFound(bit))
+          {
+            continue;
+          }
+          ++this->ScannedCubes;
+          if (!volume.Evaluate(i, j, k, st) || st.Case == 0 || st.Case == 255)
           {
             continue;
           }
@@ -564,7 +679,10 @@ private:
   ZeroedArray<std::uint64_t> Visited;  // a bit per owned cube: its nodes were all found
   std::vector<TileWork> Work;          // per tile
   std::vector<SurfaceNode> Found;
+  std::vector<Departure> Departures;
   std::int64_t NodesExpanded = 0;
+  std::int64_t ScannedCubes = 0; // cubes read by ScanRegion
+  std::int64_t PlanePoints = 0;  // grid points read by GrowFromPlane
 };
 
 } // namespace rgmc

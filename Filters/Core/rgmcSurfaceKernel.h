@@ -42,6 +42,14 @@ public:
   int GrowFromKey(std::int64_t key) { return this->Growth.GrowFromKey(key); }
   void GrowAll() { this->Growth.GrowAll(); }
   void GrowBoundary() { this->Growth.GrowBoundary(); }
+  void SetCrossRanks(bool cross) { this->Growth.CrossRanks = cross; }
+  std::vector<Departure> TakeDepartures() { return this->Growth.TakeDepartures(); }
+  void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels)
+  {
+    this->Growth.GrowFromArrivals(arrivals, numLabels);
+  }
+  std::int64_t CubesExamined() const { return this->Growth.CubesExamined(); }
+  std::int64_t PlanePointsRead() const { return this->Growth.PlanePointsRead(); }
   /// Makes the triangles of every node found (SurfaceExtraction).
   void Extract() { this->Extraction.Extract(this->Growth.Nodes()); }
 
