@@ -117,114 +117,6 @@ std::vector<Field> Fields()
   return fields;
 }
 
-/// A surface by vertex keys: triangles (sorted key triples) with their ComponentId, and each
-/// key's coordinates and normal as bits.
-struct Snapshot
-{
-  std::map<std::array<long long, 3>, int> Triangles;
-  std::map<long long, std::array<std::uint32_t, 6>> Vertices;
-  long long DuplicatedTriangles = 0;
-  long long InconsistentVertices = 0;
-  long long WrongRankIds = 0;
-
-  void Add(vtkPolyData* pd, int rank)
-  {
-    vtkIdTypeArray* keys = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
-    vtkIntArray* comps = vtkIntArray::SafeDownCast(pd->GetCellData()->GetArray("ComponentId"));
-    vtkIntArray* ranks = vtkIntArray::SafeDownCast(pd->GetCellData()->GetArray("RankId"));
-    vtkDataArray* normals = pd->GetPointData()->GetNormals();
-    if (pd->GetNumberOfPoints() == 0)
-    {
-      return;
-    }
-    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
-    {
-      float x[3], n[3];
-      double xd[3], nd[3];
-      pd->GetPoint(p, xd);
-      normals->GetTuple(p, nd);
-      std::array<std::uint32_t, 6> bits;
-      for (int a = 0; a < 3; ++a)
-      {
-        x[a] = static_cast<float>(xd[a]);
-        n[a] = static_cast<float>(nd[a]);
-        std::memcpy(&bits[a], &x[a], 4);
-        std::memcpy(&bits[3 + a], &n[a], 4);
-      }
-      auto inserted = this->Vertices.emplace(keys->GetValue(p), bits);
-      if (!inserted.second && inserted.first->second != bits)
-      {
-        ++this->InconsistentVertices;
-      }
-    }
-    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
-    {
-      vtkIdType npts;
-      const vtkIdType* pts;
-      pd->GetCellPoints(t, npts, pts);
-      std::array<long long, 3> tri = { keys->GetValue(pts[0]), keys->GetValue(pts[1]),
-        keys->GetValue(pts[2]) };
-      std::sort(tri.begin(), tri.end());
-      if (!this->Triangles.emplace(tri, comps->GetValue(t)).second)
-      {
-        ++this->DuplicatedTriangles;
-      }
-      this->WrongRankIds += ranks->GetValue(t) != rank;
-    }
-  }
-};
-
-long long Failures = 0;
-
-/// Gathers the pieces on rank 0 and compares their union with the reference.
-void CompareUnion(vtkMultiProcessController* controller, vtkPolyData* piece,
-  const Snapshot* reference, const std::string& what)
-{
-  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
-  controller->Gather(piece, pieces, 0);
-  long long failed = 0;
-  if (controller->GetLocalProcessId() == 0)
-  {
-    Snapshot united;
-    for (std::size_t r = 0; r < pieces.size(); ++r)
-    {
-      united.Add(vtkPolyData::SafeDownCast(pieces[r]), static_cast<int>(r));
-    }
-    const bool same =
-      united.Triangles == reference->Triangles && united.Vertices == reference->Vertices;
-    RGMC_CHECK(same,
-      what << ": the union differs from 1 rank: " << united.Triangles.size() << " vs "
-           << reference->Triangles.size() << " triangles, " << united.Vertices.size() << " vs "
-           << reference->Vertices.size() << " vertices");
-    RGMC_CHECK(united.DuplicatedTriangles == 0,
-      what << ": " << united.DuplicatedTriangles << " triangles on two ranks");
-    RGMC_CHECK(united.InconsistentVertices == 0,
-      what << ": " << united.InconsistentVertices << " vertices differ between ranks");
-    RGMC_CHECK(united.WrongRankIds == 0, what << ": RankId is not the rank that made the triangle");
-    failed =
-      !same || united.DuplicatedTriangles || united.InconsistentVertices || united.WrongRankIds;
-  }
-  // Every rank reports the same global counts.
-  vtkFieldData* fd = piece->GetFieldData();
-  long long triangles = fd->GetArray("NumberOfTriangles")
-    ? vtkIdTypeArray::SafeDownCast(fd->GetArray("NumberOfTriangles"))->GetValue(0)
-    : -1;
-  long long lo = 0, hi = 0;
-  controller->AllReduce(&triangles, &lo, 1, vtkCommunicator::MIN_OP);
-  controller->AllReduce(&triangles, &hi, 1, vtkCommunicator::MAX_OP);
-  RGMC_CHECK(lo == hi, what << ": ranks disagree on NumberOfTriangles");
-  Failures += failed;
-}
-
-/// The same text on every rank (compared by hash).
-bool SameOnAllRanks(vtkMultiProcessController* controller, const std::string& text)
-{
-  long long h = static_cast<long long>(std::hash<std::string>()(text) >> 1), lo = 0, hi = 0;
-  controller->AllReduce(&h, &lo, 1, vtkCommunicator::MIN_OP);
-  controller->AllReduce(&h, &hi, 1, vtkCommunicator::MAX_OP);
-  return lo == hi;
-}
-
 /// Strips what differs between ranks in a VTK message (the object's address and the source
 /// line), leaving the text.
 std::string Text(const std::string& message)
@@ -319,6 +211,7 @@ int main(int argc, char* argv[])
     vtkRGMarchingCubes::ALL_COMPONENTS };
   const char* modeNames[] = { "seeded", "largest", "all" };
   int runs = 0;
+  long long mostRounds = 0; // of growth between ranks, in a seeded run
   for (const Field& field : Fields())
   {
     // The 1-rank reference, on rank 0.
@@ -376,6 +269,27 @@ int main(int argc, char* argv[])
           }
           CompareUnion(controller, r.Output, rank == 0 ? &references[next] : nullptr, what.str());
           ++runs;
+          if (mode == vtkRGMarchingCubes::SEEDED && ranks > 1)
+          {
+            // Growth in rounds follows the structure: no rank makes a triangle that is not
+            // kept, and no rank grows in one step; every rank made the same collective calls.
+            RGMC_CHECK(!r.OneStep, what.str() << ": grew in one step");
+            RGMC_CHECK(r.TrianglesMade == r.Output->GetNumberOfCells(),
+              what.str() << ": rank " << rank << " made " << r.TrianglesMade
+                         << " triangles and kept " << r.Output->GetNumberOfCells());
+            RGMC_CHECK(r.FacePointsRead == 0, what.str() << ": face points read");
+            RGMC_CHECK(SameOnAllRanks(controller, std::to_string(r.Collectives)),
+              what.str() << ": the ranks made different numbers of collective calls");
+            long long rounds = r.Rounds, most = 0;
+            controller->AllReduce(&rounds, &most, 1, vtkCommunicator::MAX_OP);
+            mostRounds = std::max(mostRounds, most);
+            // The same in one step, as past MaximumGrowthRounds.
+            Run once = Extract(controller, image, field.Isovalue, mode, field.SeedSets[s],
+              [](vtkRGMarchingCubes* rg) { rg->SetMaximumGrowthRounds(0); });
+            RGMC_CHECK(once.Errors.empty() && once.Rounds == 0, what.str() << ": " << once.Errors);
+            CompareUnion(controller, once.Output, rank == 0 ? &references[next] : nullptr,
+              what.str() + ", in one step");
+          }
         }
       }
     }
@@ -385,5 +299,7 @@ int main(int argc, char* argv[])
     CollectiveErrors(controller);
   }
 
-  return rgmc_test::Finish(controller, "TestDistributed", std::to_string(runs) + " runs compared, ");
+  return rgmc_test::Finish(controller, "TestDistributed",
+    std::to_string(runs) + " runs compared, at most " + std::to_string(mostRounds) +
+      " rounds of seeded growth between ranks, ");
 }

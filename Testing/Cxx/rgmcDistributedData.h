@@ -7,6 +7,9 @@
 #include "rgmcThreads.h"
 
 #include "vtkExtentTranslator.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkIntArray.h"
 #include "vtkMultiProcessController.h"
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGPhantomSource.h"
@@ -147,6 +150,10 @@ struct Run
 {
   vtkSmartPointer<vtkPolyData> Output;
   std::string Errors, Warnings;
+  /// The filter's own counts of the run on this rank (see vtkRGMarchingCubes).
+  int Rounds = 0;
+  bool OneStep = false;
+  long long Collectives = 0, Messages = 0, CubesExamined = 0, FacePointsRead = 0, TrianglesMade = 0;
 };
 
 inline Run Extract(vtkMultiProcessController* controller, vtkImageData* image, double isovalue,
@@ -178,6 +185,13 @@ inline Run Extract(vtkMultiProcessController* controller, vtkImageData* image, d
   r.Output->ShallowCopy(rg->GetOutput());
   r.Errors = catcher->Errors;
   r.Warnings = catcher->Warnings;
+  r.Rounds = rg->GetNumberOfGrowthRounds();
+  r.OneStep = rg->GetGrewInOneStep();
+  r.Collectives = rg->GetNumberOfCollectives();
+  r.Messages = rg->GetNumberOfMessages();
+  r.CubesExamined = rg->GetNumberOfCubesExamined();
+  r.FacePointsRead = rg->GetNumberOfFacePointsRead();
+  r.TrianglesMade = rg->GetNumberOfTrianglesMade();
   return r;
 }
 
@@ -192,6 +206,99 @@ inline vtkSmartPointer<vtkImageData> PhantomPiece(const int extent[6], int point
   image->DeepCopy(phantom->GetOutput());
   image->GetCellData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
   return image;
+}
+
+/// A surface by vertex keys: triangles (sorted key triples) with their ComponentId, and each
+/// key's coordinates and normal as bits.
+struct Snapshot
+{
+  std::map<std::array<long long, 3>, int> Triangles;
+  std::map<long long, std::array<std::uint32_t, 6>> Vertices;
+  long long DuplicatedTriangles = 0;
+  long long InconsistentVertices = 0;
+  long long WrongRankIds = 0;
+
+  void Add(vtkPolyData* pd, int rank)
+  {
+    vtkIdTypeArray* keys = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+    vtkIntArray* comps = vtkIntArray::SafeDownCast(pd->GetCellData()->GetArray("ComponentId"));
+    vtkIntArray* ranks = vtkIntArray::SafeDownCast(pd->GetCellData()->GetArray("RankId"));
+    vtkDataArray* normals = pd->GetPointData()->GetNormals();
+    if (pd->GetNumberOfPoints() == 0)
+    {
+      return;
+    }
+    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
+    {
+      float x[3], n[3];
+      double xd[3], nd[3];
+      pd->GetPoint(p, xd);
+      normals->GetTuple(p, nd);
+      std::array<std::uint32_t, 6> bits;
+      for (int a = 0; a < 3; ++a)
+      {
+        x[a] = static_cast<float>(xd[a]);
+        n[a] = static_cast<float>(nd[a]);
+        std::memcpy(&bits[a], &x[a], 4);
+        std::memcpy(&bits[3 + a], &n[a], 4);
+      }
+      auto inserted = this->Vertices.emplace(keys->GetValue(p), bits);
+      if (!inserted.second && inserted.first->second != bits)
+      {
+        ++this->InconsistentVertices;
+      }
+    }
+    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
+    {
+      vtkIdType npts;
+      const vtkIdType* pts;
+      pd->GetCellPoints(t, npts, pts);
+      std::array<long long, 3> tri = { keys->GetValue(pts[0]), keys->GetValue(pts[1]),
+        keys->GetValue(pts[2]) };
+      std::sort(tri.begin(), tri.end());
+      if (!this->Triangles.emplace(tri, comps->GetValue(t)).second)
+      {
+        ++this->DuplicatedTriangles;
+      }
+      this->WrongRankIds += ranks->GetValue(t) != rank;
+    }
+  }
+};
+
+/// Gathers the pieces on rank 0 and compares their union with the reference.
+inline void CompareUnion(vtkMultiProcessController* controller, vtkPolyData* piece,
+  const Snapshot* reference, const std::string& what)
+{
+  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
+  controller->Gather(piece, pieces, 0);
+  if (controller->GetLocalProcessId() == 0)
+  {
+    Snapshot united;
+    for (std::size_t r = 0; r < pieces.size(); ++r)
+    {
+      united.Add(vtkPolyData::SafeDownCast(pieces[r]), static_cast<int>(r));
+    }
+    const bool same =
+      united.Triangles == reference->Triangles && united.Vertices == reference->Vertices;
+    RGMC_CHECK(same,
+      what << ": the union differs from 1 rank: " << united.Triangles.size() << " vs "
+           << reference->Triangles.size() << " triangles, " << united.Vertices.size() << " vs "
+           << reference->Vertices.size() << " vertices");
+    RGMC_CHECK(united.DuplicatedTriangles == 0,
+      what << ": " << united.DuplicatedTriangles << " triangles on two ranks");
+    RGMC_CHECK(united.InconsistentVertices == 0,
+      what << ": " << united.InconsistentVertices << " vertices differ between ranks");
+    RGMC_CHECK(united.WrongRankIds == 0, what << ": RankId is not the rank that made the triangle");
+  }
+  // Every rank reports the same global counts.
+  vtkFieldData* fd = piece->GetFieldData();
+  long long triangles = fd->GetArray("NumberOfTriangles")
+    ? vtkIdTypeArray::SafeDownCast(fd->GetArray("NumberOfTriangles"))->GetValue(0)
+    : -1;
+  long long lo = 0, hi = 0;
+  controller->AllReduce(&triangles, &lo, 1, vtkCommunicator::MIN_OP);
+  controller->AllReduce(&triangles, &hi, 1, vtkCommunicator::MAX_OP);
+  RGMC_CHECK(lo == hi, what << ": ranks disagree on NumberOfTriangles");
 }
 
 /// True when `text` is the same on every rank.
