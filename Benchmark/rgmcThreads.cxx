@@ -113,7 +113,6 @@ int main(int argc, char* argv[])
         flying->SetValue(0, 400);
         flying->ComputeNormalsOn();
         flying->ComputeScalarsOff();
-        if (getenv("ONLY_SEEDED")) { for (int r = 0; r < 20; ++r) { vtkNew<vtkRGMarchingCubes> q; q->SetInputData(image); q->SetIsovalue(400); q->AddSeedPoint(0,0,105); q->Update(); } exit(0); }
         fe = Fastest(repeats,
           [&]()
           {

@@ -12,6 +12,16 @@ Ranks::Ranks(vtkMultiProcessController* controller)
   , Rank(controller->GetLocalProcessId())
   , Size(controller->GetNumberOfProcesses())
 {
+  // Room to drain a message that finds no memory, reserved now: not touched (so it costs no
+  // memory) unless it is needed, when allocating it could fail too.
+  try
+  {
+    this->Drain.reset(new std::uint64_t[static_cast<std::size_t>(MaxChunk)]);
+  }
+  catch (const std::bad_alloc&)
+  {
+    this->Failure = "not enough memory to receive messages from the other ranks";
+  }
 }
 
 bool Ranks::Check(int status, const char* what)
@@ -66,13 +76,15 @@ bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> an
     *value = reduced[n++];
   }
   const int first = reduced[0];
-  if (first == this->Size)
-  {
-    return true;
-  }
+  return first == this->Size || this->ShareMessage(first, message);
+}
+
+bool Ranks::ShareMessage(int first, std::string& message)
+{
   vtkIdType length = this->Rank == first ? static_cast<vtkIdType>(message.size()) : 0;
-  this->Collectives += length > 0 ? 2 : 1;
+  ++this->Collectives;
   this->C->Broadcast(&length, 1, first);
+  this->Collectives += length > 0 ? 1 : 0;
   std::vector<char> text(static_cast<std::size_t>(length) + 1, '\0');
   if (this->Rank == first)
   {
@@ -164,7 +176,6 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
       this->Check(this->C->Receive(&count, 1, partner, tag), "receiving a message's size");
       std::vector<T>& in = incoming[partner];
       T* target = nullptr;
-      std::vector<T> drain;
       try
       {
         in.resize(static_cast<std::size_t>(count));
@@ -181,11 +192,13 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
       for (vtkIdType at = 0; at < count; at += MaxChunk)
       {
         const vtkIdType length = std::min(MaxChunk, count - at);
-        if (!target)
+        static_assert(sizeof(T) == sizeof(std::uint64_t), "messages carry 64-bit values");
+        T* drain = reinterpret_cast<T*>(this->Drain.get());
+        if (!target && !drain)
         {
-          drain.resize(static_cast<std::size_t>(MaxChunk)); // a small, fixed buffer
+          break; // the agreement that follows fails anyway (Failure is set)
         }
-        this->Check(this->C->Receive(target ? target + at : drain.data(), length, partner, tag + 1),
+        this->Check(this->C->Receive(target ? target + at : drain, length, partner, tag + 1),
           "receiving a message");
       }
     };

@@ -8,8 +8,10 @@
 #include "vtkMultiProcessController.h"
 #include "vtkType.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <initializer_list>
+#include <memory>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -35,6 +37,38 @@ public:
   /// reduced even when the status fails.
   bool Agree(bool ok, std::string& message, std::initializer_list<bool*> anyOf,
     std::initializer_list<int*> minimums = {});
+
+  /// Agree, and in the same collective call give every rank the `mine` of every rank (each
+  /// rank passes the same number of values): `all` holds them rank after rank. The values are
+  /// gathered even when the status fails.
+  template <typename T>
+  bool AgreeGather(bool ok, std::string& message, const std::vector<T>& mine, std::vector<T>& all)
+  {
+    std::vector<T> sent(1 + mine.size()), gathered(sent.size() * this->Size);
+    if (ok && !this->Failure.empty())
+    {
+      ok = false;
+      message = this->Failure;
+    }
+    this->Failure.clear();
+    sent[0] = static_cast<T>(ok ? this->Size : this->Rank);
+    std::copy(mine.begin(), mine.end(), sent.begin() + 1);
+    ++this->Collectives;
+    if (this->C->AllGather(sent.data(), gathered.data(), static_cast<vtkIdType>(sent.size())) != 1)
+    {
+      message = "communication between the ranks failed (agreeing on a status)";
+      return false;
+    }
+    int first = this->Size;
+    all.resize(mine.size() * this->Size);
+    for (int r = 0; r < this->Size; ++r)
+    {
+      const T* from = gathered.data() + r * sent.size();
+      first = std::min(first, static_cast<int>(from[0]));
+      std::copy(from + 1, from + sent.size(), all.begin() + r * mine.size());
+    }
+    return first == this->Size || this->ShareMessage(first, message);
+  }
 
   /// Runs `work` (local work, no communication) unless `problem` is already set; an allocation
   /// failure becomes the problem "not enough memory to <what>". Then agrees, as Agree does.
@@ -135,7 +169,11 @@ public:
   static constexpr vtkIdType MaxChunk = vtkIdType(1) << 20;
 
 private:
-  std::string Failure; // the first failed communication since the last agreement
+  std::string Failure;                    // the first failed communication since the last agreement
+  std::unique_ptr<std::uint64_t[]> Drain; // MaxChunk values, for messages without memory
+
+  /// Gives every rank the message of rank `first` (a failed agreement); returns false.
+  bool ShareMessage(int first, std::string& message);
 
   /// The partners of `partners` in the order of a round-robin tournament over all ranks.
   std::vector<int> TournamentOrder(const std::vector<bool>& partners) const;

@@ -372,221 +372,246 @@ struct Decision
   vtkIdType Components = 0;
 };
 
-/// Joins the local components of all ranks through their ports and decides, on rank 0, which
-/// to keep. Collective; false on every rank (with `problem`) when it failed on one.
-bool Resolve(Ranks& ranks, AnyKernel& kernel, const rgmc::Grid& grid, const rgmc::Ownership& own,
-  int mode, std::vector<int>& rootIndex, Decision& decision, std::string& problem)
+/// A component of some rank in one number: the rank and its root's index there.
+vtkIdType RankComponent(int rank, vtkIdType root)
 {
-  rgmc::ComponentSet& comps = kernel.Components();
-  std::vector<int> roots;
+  return (static_cast<vtkIdType>(rank) << 32) | root;
+}
+
+/// This rank's part of the component graph, made after extraction: its root components (their
+/// totals, which rank 0 needs) and the ports that join them to other ranks' components.
+struct ComponentGraph
+{
+  std::vector<int> RootIndex;                            // per local component: its root's index
+  std::vector<vtkIdType> Part;                           // 3 values per root, then 2 per edge
+  std::vector<std::vector<vtkIdType>> PortsTo;           // per rank: (key, root index) pairs
+  std::vector<std::pair<std::int64_t, vtkIdType>> Ports; // (key, root index), sorted
+  vtkIdType Roots = 0;
+  vtkIdType Edges = 0;
+
+  /// Numbers the roots, lists their totals, and sorts the ports by the ranks that own the other
+  /// cubes around them. Local work.
+  void Prepare(
+    AnyKernel& kernel, const rgmc::Grid& grid, const rgmc::Ownership& own, int rank, int numRanks)
+  {
+    rgmc::ComponentSet& comps = kernel.Components();
+    this->RootIndex.assign(comps.Size(), -1);
+    for (int c = 0; c < comps.Size(); ++c)
+    {
+      if (comps.Root(c) == c)
+      {
+        const rgmc::ComponentSet::Totals& totals = comps.TotalsOf(c);
+        this->RootIndex[c] = static_cast<int>(this->Roots++);
+        this->Part.push_back(totals.Triangles);
+        this->Part.push_back(totals.MinKey);
+        this->Part.push_back(totals.Seeded ? 1 : 0);
+      }
+    }
+    for (int c = 0; c < comps.Size(); ++c)
+    {
+      this->RootIndex[c] = this->RootIndex[comps.Root(c)];
+    }
+    this->PortsTo.resize(static_cast<std::size_t>(numRanks));
+    for (const rgmc::Port& port : kernel.Ports())
+    {
+      const vtkIdType root = this->RootIndex[port.Component];
+      this->Ports.emplace_back(port.Key, root);
+      ForOtherOwners(grid, own, rank, port.Key,
+        [&](int owner)
+        {
+          this->PortsTo[owner].push_back(port.Key);
+          this->PortsTo[owner].push_back(root);
+        });
+    }
+    std::sort(this->Ports.begin(), this->Ports.end());
+  }
+
+  /// Appends the edges between this rank's components and the neighbours' that share a port
+  /// (each once), as pairs of RankComponent numbers.
+  void Join(const std::vector<std::vector<vtkIdType>>& incoming, int rank)
+  {
+    std::vector<std::pair<vtkIdType, vtkIdType>> edges;
+    for (int from = 0; from < static_cast<int>(incoming.size()); ++from)
+    {
+      const std::vector<vtkIdType>& list = incoming[from];
+      for (std::size_t n = 0; from != rank && n + 1 < list.size(); n += 2)
+      {
+        auto it = std::lower_bound(this->Ports.begin(), this->Ports.end(),
+          std::make_pair(
+            static_cast<std::int64_t>(list[n]), std::numeric_limits<vtkIdType>::min()));
+        if (it != this->Ports.end() && it->first == list[n])
+        {
+          const vtkIdType mine = RankComponent(rank, it->second);
+          const vtkIdType theirs = RankComponent(from, list[n + 1]);
+          edges.emplace_back(std::min(mine, theirs), std::max(mine, theirs));
+        }
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    for (const auto& e : edges)
+    {
+      this->Part.push_back(e.first);
+      this->Part.push_back(e.second);
+    }
+    this->Edges = static_cast<vtkIdType>(edges.size());
+  }
+};
+
+/// On rank 0: joins the components of all ranks (`parts`, rank after rank, of `roots[r]`
+/// roots and `edges[r]` edges each) and decides which to keep. Writes, for each rank r at
+/// `out + offset[r]`, its header (0, the kept triangles, the kept components) and the final id
+/// of each of its roots (-1: dropped).
+void Decide(int mode, const std::vector<vtkIdType>& parts, const std::vector<vtkIdType>& roots,
+  const std::vector<vtkIdType>& edges, const std::vector<vtkIdType>& scatterOffsets, vtkIdType* out)
+{
+  const int numRanks = static_cast<int>(roots.size());
+  std::vector<vtkIdType> first(numRanks + 1, 0); // dense number of each rank's first root
+  for (int r = 0; r < numRanks; ++r)
+  {
+    first[r + 1] = first[r] + roots[r];
+  }
+  const vtkIdType total = first[numRanks];
+  rgmc::UnionFind<vtkIdType> sets;
+  sets.Reset(static_cast<std::size_t>(total));
+  struct Class
+  {
+    vtkIdType Triangles = 0;
+    vtkIdType MinKey = std::numeric_limits<vtkIdType>::max();
+    bool Seeded = false;
+  };
+  std::vector<Class> classes(static_cast<std::size_t>(total));
+  const vtkIdType* at = parts.data();
+  std::vector<std::array<vtkIdType, 3>> info(static_cast<std::size_t>(total));
+  for (int r = 0; r < numRanks; ++r)
+  {
+    for (vtkIdType c = 0; c < roots[r]; ++c, at += 3)
+    {
+      info[first[r] + c] = { at[0], at[1], at[2] };
+    }
+    for (vtkIdType e = 0; e < edges[r]; ++e, at += 2)
+    {
+      auto dense = [&first](vtkIdType rc) { return first[rc >> 32] + (rc & 0xffffffff); };
+      sets.Unite(dense(at[0]), dense(at[1]));
+    }
+  }
+  for (vtkIdType c = 0; c < total; ++c)
+  {
+    Class& k = classes[sets.Find(c)];
+    k.Triangles += info[c][0];
+    k.MinKey = std::min(k.MinKey, info[c][1]);
+    k.Seeded = k.Seeded || info[c][2] != 0;
+  }
+  std::vector<vtkIdType> selected;
+  vtkIdType largest = -1;
+  for (vtkIdType c = 0; c < total; ++c)
+  {
+    if (sets.Find(c) != c || classes[c].Triangles == 0)
+    {
+      continue;
+    }
+    if (mode == vtkRGMarchingCubes::ALL_COMPONENTS ||
+      (mode == vtkRGMarchingCubes::SEEDED && classes[c].Seeded))
+    {
+      selected.push_back(c);
+    }
+    if (largest < 0 || classes[c].Triangles > classes[largest].Triangles ||
+      (classes[c].Triangles == classes[largest].Triangles &&
+        classes[c].MinKey < classes[largest].MinKey))
+    {
+      largest = c;
+    }
+  }
+  if (mode == vtkRGMarchingCubes::LARGEST_COMPONENT && largest >= 0)
+  {
+    selected.push_back(largest);
+  }
+  std::sort(selected.begin(), selected.end(),
+    [&classes](vtkIdType a, vtkIdType b) { return classes[a].MinKey < classes[b].MinKey; });
+  std::vector<vtkIdType> idOfClass(static_cast<std::size_t>(total), -1);
+  vtkIdType triangles = 0;
+  for (std::size_t n = 0; n < selected.size(); ++n)
+  {
+    idOfClass[selected[n]] = static_cast<vtkIdType>(n);
+    triangles += classes[selected[n]].Triangles;
+  }
+  for (int r = 0; r < numRanks; ++r)
+  {
+    vtkIdType* header = out + scatterOffsets[r];
+    header[0] = 0;
+    header[1] = triangles;
+    header[2] = static_cast<vtkIdType>(selected.size());
+    for (vtkIdType c = 0; c < roots[r]; ++c)
+    {
+      header[3 + c] = idOfClass[sets.Find(first[r] + c)];
+    }
+  }
+}
+
+/// Gathers the component graph (each rank's part, sizes known to all from `roots` and
+/// `edges`) on rank 0, which decides, and gives each rank its decision. Collective; false (with
+/// `problem`) when it failed, on every rank alike (rank 0's verdict comes with the decision),
+/// but not yet agreed: the caller's next agreement does that.
+bool Resolve(Ranks& ranks, int mode, const ComponentGraph& graph,
+  const std::vector<vtkIdType>& roots, const std::vector<vtkIdType>& edges, Decision& decision,
+  std::string& problem)
+{
+  const int size = ranks.Size;
+  std::vector<vtkIdType> gatherLengths(size), gatherOffsets(size + 1, 0);
+  std::vector<vtkIdType> scatterLengths(size), scatterOffsets(size + 1, 0);
+  for (int r = 0; r < size; ++r)
+  {
+    gatherLengths[r] = 3 * roots[r] + 2 * edges[r];
+    gatherOffsets[r + 1] = gatherOffsets[r] + gatherLengths[r];
+    scatterLengths[r] = 3 + roots[r]; // the header, then the roots' final ids
+    scatterOffsets[r + 1] = scatterOffsets[r] + scatterLengths[r];
+  }
+  std::vector<vtkIdType> parts, decided, mine;
   if (!ranks.Step("join the components", problem,
         [&]()
         {
-          rootIndex.assign(comps.Size(), -1);
-          for (int c = 0; c < comps.Size(); ++c)
-          {
-            if (comps.Root(c) == c)
-            {
-              rootIndex[c] = static_cast<int>(roots.size());
-              roots.push_back(c);
-            }
-          }
-          for (int c = 0; c < comps.Size(); ++c)
-          {
-            rootIndex[c] = rootIndex[comps.Root(c)];
-          }
+          parts.resize(ranks.Rank == 0 ? gatherOffsets[size] + 1 : 1);
+          decided.resize(ranks.Rank == 0 ? scatterOffsets[size] : 1);
+          mine.resize(static_cast<std::size_t>(scatterLengths[ranks.Rank]));
         }))
   {
     return false;
   }
-
-  vtkIdType localCount = static_cast<vtkIdType>(roots.size());
-  std::vector<vtkIdType> counts(ranks.Size), offsets(ranks.Size + 1, 0);
-  ranks.AllGather(&localCount, counts.data(), 1, "gathering component counts");
-  for (int r = 0; r < ranks.Size; ++r)
+  ranks.GatherV(graph.Part.data(), parts.data(), gatherLengths[ranks.Rank], gatherLengths.data(),
+    gatherOffsets.data(), 0, "gathering the components");
+  if (ranks.Rank == 0)
   {
-    offsets[r + 1] = offsets[r] + counts[r];
+    try
+    {
+      Decide(mode, parts, roots, edges, scatterOffsets, decided.data());
+    }
+    catch (const std::bad_alloc&)
+    {
+      for (int r = 0; r < size; ++r)
+      {
+        decided[scatterOffsets[r]] = 1; // the verdict every rank reads
+      }
+    }
   }
-  const vtkIdType myOffset = offsets[ranks.Rank];
-
-  // Ports go to the ranks that own the other cubes around them.
-  std::vector<std::vector<vtkIdType>> outgoing(ranks.Size);
-  std::vector<std::pair<std::int64_t, vtkIdType>> mine;
-  if (!ranks.Step("list the components' crossings", problem,
-        [&]()
-        {
-          for (const rgmc::Port& port : kernel.Ports())
-          {
-            const vtkIdType gid = myOffset + rootIndex[port.Component];
-            mine.emplace_back(port.Key, gid);
-            ForOtherOwners(grid, own, ranks.Rank, port.Key,
-              [&](int owner)
-              {
-                outgoing[owner].push_back(port.Key);
-                outgoing[owner].push_back(gid);
-              });
-          }
-        }))
+  ranks.ScatterV(decided.data(), mine.data(), scatterLengths.data(), scatterOffsets.data(),
+    scatterLengths[ranks.Rank], 0, "scattering the decision");
+  if (mine[0] == 1)
   {
+    problem = "not enough memory on rank 0 to decide which components to keep";
     return false;
   }
-  const std::vector<std::vector<vtkIdType>> incoming =
-    ranks.ExchangeInOrder(outgoing, own.MeetingOrder(), PortTag);
-
-  // Edges of the component graph: my component and theirs share a vertex.
-  const vtkIdType total = offsets[ranks.Size];
-  std::vector<vtkIdType> info, flatEdges, allInfo;
-  std::vector<vtkIdType> infoLengths(ranks.Size), infoOffsets(ranks.Size);
-  if (!ranks.Step("join the components", problem,
-        [&]()
-        {
-          std::sort(mine.begin(), mine.end());
-          std::vector<std::pair<vtkIdType, vtkIdType>> edges;
-          for (const std::vector<vtkIdType>& list : incoming)
-          {
-            for (std::size_t n = 0; n + 1 < list.size(); n += 2)
-            {
-              auto it = std::lower_bound(mine.begin(), mine.end(),
-                std::make_pair(
-                  static_cast<std::int64_t>(list[n]), std::numeric_limits<vtkIdType>::min()));
-              if (it != mine.end() && it->first == list[n])
-              {
-                edges.emplace_back(
-                  std::min(it->second, list[n + 1]), std::max(it->second, list[n + 1]));
-              }
-            }
-          }
-          std::sort(edges.begin(), edges.end());
-          edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-
-          // Gather the small component graph on rank 0.
-          info.reserve(3 * roots.size());
-          for (int c : roots)
-          {
-            const rgmc::ComponentSet::Totals& totals = comps.TotalsOf(c);
-            info.push_back(totals.Triangles);
-            info.push_back(totals.MinKey);
-            info.push_back(totals.Seeded ? 1 : 0);
-          }
-          for (const auto& e : edges)
-          {
-            flatEdges.push_back(e.first);
-            flatEdges.push_back(e.second);
-          }
-          for (int r = 0; r < ranks.Size; ++r)
-          {
-            infoLengths[r] = 3 * counts[r];
-            infoOffsets[r] = 3 * offsets[r];
-          }
-          allInfo.resize(ranks.Rank == 0 ? 3 * total + 1 : 1);
-        }))
-  {
-    return false;
-  }
-  ranks.GatherV(info.data(), allInfo.data(), static_cast<vtkIdType>(info.size()),
-    infoLengths.data(), infoOffsets.data(), 0, "gathering the components");
-  vtkIdType edgeLength = static_cast<vtkIdType>(flatEdges.size());
-  std::vector<vtkIdType> edgeLengths(ranks.Size), edgeOffsets(ranks.Size + 1, 0);
-  // Every rank learns every length: VTK 9.5's GatherV reads the lengths and offsets on all ranks.
-  ranks.AllGather(&edgeLength, edgeLengths.data(), 1, "gathering edge counts");
-  for (int r = 0; r < ranks.Size; ++r)
-  {
-    edgeOffsets[r + 1] = edgeOffsets[r] + edgeLengths[r];
-  }
-  std::vector<vtkIdType> allEdges, finalIds;
-  if (!ranks.Step("join the components", problem,
-        [&]() { allEdges.resize(ranks.Rank == 0 ? edgeOffsets[ranks.Size] + 1 : 1); }))
-  {
-    return false;
-  }
-  ranks.GatherV(flatEdges.data(), allEdges.data(), edgeLength, edgeLengths.data(),
-    edgeOffsets.data(), 0, "gathering the component graph");
-
-  vtkIdType totals[2] = { 0, 0 };
-  if (!ranks.Step("decide which components to keep", problem,
-        [&]()
-        {
-          finalIds.assign(ranks.Rank == 0 ? total + 1 : 1, -1);
-          if (ranks.Rank == 0)
-          {
-            rgmc::UnionFind<vtkIdType> sets;
-            sets.Reset(static_cast<std::size_t>(total));
-            auto find = [&sets](vtkIdType x) { return sets.Find(x); };
-            for (vtkIdType n = 0; n + 1 < edgeOffsets[ranks.Size]; n += 2)
-            {
-              sets.Unite(allEdges[n], allEdges[n + 1]);
-            }
-            struct Class
-            {
-              vtkIdType Triangles = 0;
-              vtkIdType MinKey = std::numeric_limits<vtkIdType>::max();
-              bool Seeded = false;
-            };
-            std::vector<Class> classes(total);
-            for (vtkIdType c = 0; c < total; ++c)
-            {
-              Class& k = classes[find(c)];
-              k.Triangles += allInfo[3 * c];
-              k.MinKey = std::min(k.MinKey, allInfo[3 * c + 1]);
-              k.Seeded = k.Seeded || allInfo[3 * c + 2] != 0;
-            }
-            std::vector<vtkIdType> selected;
-            vtkIdType largest = -1;
-            for (vtkIdType c = 0; c < total; ++c)
-            {
-              if (find(c) != c || classes[c].Triangles == 0)
-              {
-                continue;
-              }
-              if (mode == vtkRGMarchingCubes::ALL_COMPONENTS ||
-                (mode == vtkRGMarchingCubes::SEEDED && classes[c].Seeded))
-              {
-                selected.push_back(c);
-              }
-              if (largest < 0 || classes[c].Triangles > classes[largest].Triangles ||
-                (classes[c].Triangles == classes[largest].Triangles &&
-                  classes[c].MinKey < classes[largest].MinKey))
-              {
-                largest = c;
-              }
-            }
-            if (mode == vtkRGMarchingCubes::LARGEST_COMPONENT && largest >= 0)
-            {
-              selected.push_back(largest);
-            }
-            std::sort(selected.begin(), selected.end(),
-              [&classes](vtkIdType a, vtkIdType b)
-              { return classes[a].MinKey < classes[b].MinKey; });
-            std::vector<vtkIdType> idOfClass(total, -1);
-            for (std::size_t n = 0; n < selected.size(); ++n)
-            {
-              idOfClass[selected[n]] = static_cast<vtkIdType>(n);
-              totals[0] += classes[selected[n]].Triangles;
-            }
-            totals[1] = static_cast<vtkIdType>(selected.size());
-            for (vtkIdType c = 0; c < total; ++c)
-            {
-              finalIds[c] = idOfClass[find(c)];
-            }
-          }
-          decision.FinalId.assign(static_cast<std::size_t>(localCount) + 1, -1);
-        }))
-  {
-    return false;
-  }
-  ranks.ScatterV(finalIds.data(), decision.FinalId.data(), counts.data(), offsets.data(),
-    localCount, 0, "scattering the decision");
-  decision.FinalId.resize(static_cast<std::size_t>(localCount));
-  ranks.BroadcastValues(totals, 2, 0, "broadcasting the totals");
-  decision.Triangles = totals[0];
-  decision.Components = totals[1];
+  decision.Triangles = mine[1];
+  decision.Components = mine[2];
+  decision.FinalId.assign(mine.begin() + 3, mine.end());
   // Component ids are 32-bit in the output (ComponentId, like vtkConnectivityFilter's RegionId).
   if (decision.Components > VTK_INT_MAX)
   {
     problem = "the surface has " + std::to_string(decision.Components) +
       " components, more than ComponentId can number (" + std::to_string(VTK_INT_MAX) + ")";
+    return false;
   }
-  return ranks.Agree(problem.empty(), problem);
+  // A failed gather or scatter is reported at the next agreement (StoreSurface's).
+  return true;
 }
 
 /// Global range of the scalars (only on failure paths, to explain an empty result).
@@ -688,9 +713,12 @@ struct vtkRGMarchingCubes::Run
   std::unique_ptr<rgmc::Ownership> own;
   std::unique_ptr<rgmc::Grid> grid;
   std::unique_ptr<AnyKernel> kernel;
+  std::vector<rgmc::CellBox> cellBoxes;   // per rank: its cells not marked ghost
+  std::vector<rgmc::CellBox> extentBoxes; // per rank: all the cells of its extent
   std::vector<vtkIdType> seedKeys;
   std::vector<double> seedPoints;
-  std::vector<int> rootIndex;
+  ComponentGraph graph;
+  std::vector<vtkIdType> roots, edges; // per rank: the sizes of its part of the graph
   Decision decision;
   int rounds = 0;       // rounds of growth between ranks
   bool oneStep = false; // the rest grown in one step (GrowBoundary) or a full scan
@@ -699,18 +727,23 @@ struct vtkRGMarchingCubes::Run
 
 //------------------------------------------------------------------------------
 // The collective schedule: every rank runs these passes in this order and makes the same
-// collective calls in each (an Agree is one reduction on success, a broadcast more on failure);
-// a pass that fails returns on every rank at the same point.
+// collective calls in each (an agreement is one collective call on success, one or two
+// broadcasts more on failure); a pass that fails returns on every rank at the same point.
+// Seeded on N ranks with R rounds of growth between ranks: 9 + R collective calls on success
+// and R + 1 exchanges with the neighbours; Largest and All: 8 and 1.
 //
-//  PASS 0 CheckInput       AllReduce (whole extent), Agree (status, any rank with points, the
-//                          lowest such rank), Broadcast (its geometry)
-//  PASS 1 AssignCubes      AllGather (owned and held cell boxes), Any (holes in the ownership)
-//  PASS 2 FindSeeds        Seeded mode only: Agree (seed outside the volume, NaN), 3 AllReduce
-//                          (nearest vertex: distance, key, position), GlobalRange when none
-//  PASS 3 GrowAndExtract   Agree (status, aborted, ghosts missing)
-//  PASS 4 Resolve          AllGather, Agree, Exchange (ports with neighbours), Agree, GatherV,
-//                          AllGather, Agree, GatherV, Agree, ScatterV, Broadcast, Agree
-//  PASS 5 StoreSurface     Agree
+//  PASS 0 CheckInput       AllReduce (whole extent), agreement gathering every rank's boxes
+//                          of cells, whether it has points, and its geometry
+//  PASS 1 AssignCubes      none (ownership and neighbours from the gathered boxes)
+//  PASS 2 FindSeeds        Seeded mode only: agreement gathering each rank's nearest vertex
+//                          to each seed; GlobalRange (2 AllReduce) when there is none
+//  PASS 3 GrowAndExtract   Seeded on several ranks: per round an agreement (status, anything
+//                          sent) and, if something was, an exchange with the neighbours. Then
+//                          an exchange of ports with the neighbours, and an agreement
+//                          gathering the status, abort, missing ghosts and graph sizes
+//  PASS 4 Resolve          agreement (memory for the graph), GatherV (the graph to rank 0),
+//                          ScatterV (the decision, with rank 0's verdict)
+//  PASS 5 StoreSurface     agreement (also on what Resolve found)
 //         DescribeSurface  GlobalRange when the surface is empty (2 AllReduce)
 int vtkRGMarchingCubes::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
@@ -739,7 +772,7 @@ int vtkRGMarchingCubes::RequestData(
   }
   this->UpdateProgress(0.05);
   // PASS 1: ownership of cubes.
-  this->AssignCubes(run, input);
+  this->AssignCubes(run);
   // PASS 2: seeds, each to its nearest surface vertex over all ranks.
   if (this->ExtractionMode == SEEDED)
   {
@@ -758,14 +791,9 @@ int vtkRGMarchingCubes::RequestData(
     return grown == 0 ? 1 : 0; // aborted, or an error
   }
   this->UpdateProgress(0.8);
-  // PASS 4: join components across ranks; decide what to keep.
-  if (!Resolve(run.ranks, *run.kernel, *run.grid, *run.own, this->ExtractionMode, run.rootIndex,
-        run.decision, run.problem))
-  {
-    vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
-    output->Initialize();
-    return 0;
-  }
+  // PASS 4: join components across ranks; decide what to keep (agreed in pass 5).
+  Resolve(
+    run.ranks, this->ExtractionMode, run.graph, run.roots, run.edges, run.decision, run.problem);
   this->UpdateProgress(0.9);
   // PASS 5: the output piece.
   if (!this->StoreSurface(run, output))
@@ -891,76 +919,85 @@ bool vtkRGMarchingCubes::CheckInput(
     }
   }
   run.problem = msg.str();
-  // One agreement: the status, whether any rank has points, and the lowest rank that has, whose
-  // geometry everybody takes (a rank without data may carry default geometry).
-  bool anyPoints = run.hasPoints;
-  int source = run.hasPoints ? ranks.Rank : ranks.Size;
-  if (!ranks.Agree(run.problem.empty(), run.problem, { &anyPoints }, { &source }))
+  // One agreement that also gathers each rank's cells (those not marked ghost, and all of its
+  // extent), whether it has points, and its geometry: the lowest rank with points gives
+  // everybody its geometry (a rank without data may carry default geometry).
+  rgmc::CellBox myCells, allMine;
+  if (run.problem.empty() && run.hasPoints && run.scalars)
+  {
+    input->GetExtent(run.local);
+    myCells = OwnedCells(input);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    allMine.Lo[a] = run.local[2 * a];
+    allMine.Hi[a] = run.local[2 * a + 1] - 1;
+  }
+  constexpr std::size_t PerRank = 1 + 12 + 15;
+  std::vector<double> mine(PerRank, 0.0), all;
+  mine[0] = run.hasPoints ? 1.0 : 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    mine[1 + a] = myCells.Lo[a];
+    mine[4 + a] = myCells.Hi[a];
+    mine[7 + a] = allMine.Lo[a];
+    mine[10 + a] = allMine.Hi[a];
+  }
+  if (run.hasPoints)
+  {
+    input->GetOrigin(&mine[13]);
+    input->GetSpacing(&mine[16]);
+    std::copy_n(input->GetDirectionMatrix()->GetData(), 9, &mine[19]);
+  }
+  if (!ranks.AgreeGather(run.problem.empty(), run.problem, mine, all))
   {
     return false;
   }
-  if (!anyPoints)
+  int source = -1;
+  run.cellBoxes.resize(ranks.Size);
+  run.extentBoxes.resize(ranks.Size);
+  for (int r = ranks.Size - 1; r >= 0; --r)
+  {
+    const double* theirs = &all[PerRank * r];
+    source = theirs[0] != 0.0 ? r : source;
+    for (int a = 0; a < 3; ++a)
+    {
+      run.cellBoxes[r].Lo[a] = static_cast<int>(theirs[1 + a]);
+      run.cellBoxes[r].Hi[a] = static_cast<int>(theirs[4 + a]);
+      run.extentBoxes[r].Lo[a] = static_cast<int>(theirs[7 + a]);
+      run.extentBoxes[r].Hi[a] = static_cast<int>(theirs[10 + a]);
+    }
+  }
+  if (source < 0)
   {
     run.problem = "the input image has no points"; // the same verdict on every rank
     return false;
   }
-  double g[15];
-  if (ranks.Rank == source)
-  {
-    input->GetOrigin(g);
-    input->GetSpacing(g + 3);
-    const double* d = input->GetDirectionMatrix()->GetData();
-    std::copy_n(d, 9, g + 6);
-  }
-  ranks.BroadcastValues(g, 15, source, "a broadcast");
-  std::copy_n(g, 3, run.geometry.Origin);
-  std::copy_n(g + 3, 3, run.geometry.Spacing);
-  std::copy_n(g + 6, 9, run.geometry.Direction);
+  const double* g = &all[PerRank * source];
+  std::copy_n(g + 13, 3, run.geometry.Origin);
+  std::copy_n(g + 16, 3, run.geometry.Spacing);
+  std::copy_n(g + 19, 9, run.geometry.Direction);
   return true;
 }
 
 //------------------------------------------------------------------------------
-void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
+void vtkRGMarchingCubes::AssignCubes(Run& run)
 {
   Ranks& ranks = run.ranks;
   const int* whole = run.whole;
-  int* local = run.local;
-  rgmc::CellBox myCells;
-  if (run.hasPoints && run.scalars)
-  {
-    input->GetExtent(local);
-    myCells = OwnedCells(input);
-  }
-  // Each rank's owned cells (from its ghost array) and all its cells (its extent).
-  rgmc::CellBox allMine;
-  for (int a = 0; a < 3; ++a)
-  {
-    allMine.Lo[a] = local[2 * a];
-    allMine.Hi[a] = local[2 * a + 1] - 1;
-  }
-  std::vector<int> boxes(12 * ranks.Size);
-  {
-    const int mine[12] = { myCells.Lo[0], myCells.Lo[1], myCells.Lo[2], myCells.Hi[0],
-      myCells.Hi[1], myCells.Hi[2], allMine.Lo[0], allMine.Lo[1], allMine.Lo[2], allMine.Hi[0],
-      allMine.Hi[1], allMine.Hi[2] };
-    ranks.AllGather(mine, boxes.data(), 12, "a gather");
-  }
-  std::vector<rgmc::CellBox> cellBoxes(ranks.Size), extentBoxes(ranks.Size);
-  for (int r = 0; r < ranks.Size; ++r)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      cellBoxes[r].Lo[a] = boxes[12 * r + a];
-      cellBoxes[r].Hi[a] = boxes[12 * r + 3 + a];
-      extentBoxes[r].Lo[a] = boxes[12 * r + 6 + a];
-      extentBoxes[r].Hi[a] = boxes[12 * r + 9 + a];
-    }
-  }
+  std::vector<rgmc::CellBox>& cellBoxes = run.cellBoxes;
+  const std::vector<rgmc::CellBox>& extentBoxes = run.extentBoxes;
   // Ghost markings that leave cells of a piece owned by no rank (a reader whose ghost arrays do
   // not match its pieces) would silently lose the surface there. Then own by the extents: first
   // without the one ghost layer asked for at faces inside the volume (the pipeline's
-  // convention), else whole, the lowest rank holding a cell owning it.
-  if (ranks.Any(!rgmc::Covers(cellBoxes, allMine)))
+  // convention), else whole, the lowest rank holding a cell owning it. Every rank knows every
+  // box, so every rank finds the same.
+  bool holes = false;
+  for (const rgmc::CellBox& b : extentBoxes)
+  {
+    holes = holes || !rgmc::Covers(cellBoxes, b);
+  }
+  if (holes)
   {
     std::vector<rgmc::CellBox> trimmed = extentBoxes;
     for (rgmc::CellBox& b : trimmed)
@@ -971,7 +1008,6 @@ void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
         b.Hi[a] -= b.Hi[a] < whole[2 * a + 1] - 1 ? 1 : 0;
       }
     }
-    // Covers() of the gathered boxes is the same on every rank: no reduction needed.
     bool trimmedCovers = true;
     for (const rgmc::CellBox& b : extentBoxes)
     {
@@ -987,7 +1023,7 @@ void vtkRGMarchingCubes::AssignCubes(Run& run, vtkImageData* input)
     }
   }
   run.own.reset(new rgmc::Ownership(cellBoxes, ranks.Rank));
-  run.grid.reset(new rgmc::Grid(whole, local));
+  run.grid.reset(new rgmc::Grid(whole, run.local));
 
   rgmc::SurfaceOptions options;
   options.Isovalue = this->Isovalue;
@@ -1053,55 +1089,49 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
       }
     }
   }
-  // Each rank's nearest vertex to each seed; a NaN met on the way is an error.
-  std::vector<rgmc::SeedHit> hits(numSeeds);
-  bool isOutside = !outside.str().empty();
-  if (!isOutside)
+  // A seed outside the volume: the same verdict on every rank (the geometry is agreed).
+  if (!outside.str().empty())
   {
-    const double minStep = geom.MinStep();
-    for (int s = 0; s < numSeeds; ++s)
-    {
-      hits[s] = run.kernel->NearestVertex(
-        &seedIndex[3 * s], &this->SeedPoints[3 * s], this->SeedSearchRadius, minStep);
-    }
+    vtkWarningMacro(<< "No surface extracted: " << outside.str() << ".");
+    return 0;
   }
-  run.problem = isOutside ? outside.str() : run.kernel->Error();
-  if (!ranks.Agree(run.problem.empty(), run.problem, { &isOutside }))
+  // Each rank's nearest vertex to each seed (a NaN met on the way is an error), gathered in the
+  // agreement: found, squared distance, key (exact in a double: below 2^53), position.
+  const double minStep = geom.MinStep();
+  std::vector<double> mine(5 * numSeeds), all;
+  for (int s = 0; s < numSeeds; ++s)
   {
-    if (isOutside)
-    {
-      vtkWarningMacro(<< "No surface extracted: " << run.problem << ".");
-      return 0;
-    }
+    const rgmc::SeedHit hit = run.kernel->NearestVertex(
+      &seedIndex[3 * s], &this->SeedPoints[3 * s], this->SeedSearchRadius, minStep);
+    mine[5 * s] = hit.Found ? hit.Distance2 : VTK_DOUBLE_MAX;
+    mine[5 * s + 1] = hit.Found ? static_cast<double>(hit.Key) : -1.0;
+    std::copy_n(hit.Point, 3, &mine[5 * s + 2]);
+  }
+  run.problem = run.kernel->Error();
+  if (!ranks.AgreeGather(run.problem.empty(), run.problem, mine, all))
+  {
     vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
     return -1;
   }
-  // The global nearest: smallest distance, then smallest key, then its position.
-  std::vector<double> d2(numSeeds), bestD2(numSeeds);
+  // The global nearest: smallest distance, then smallest key (the same point on every rank
+  // that has it).
+  std::vector<vtkIdType> bestKeys(numSeeds, std::numeric_limits<vtkIdType>::max());
+  std::vector<double> bestPoints(3 * numSeeds, 0.0);
   for (int s = 0; s < numSeeds; ++s)
   {
-    d2[s] = hits[s].Distance2;
-  }
-  ranks.AllReduce(d2.data(), bestD2.data(), numSeeds, vtkCommunicator::MIN_OP, "a reduction");
-  std::vector<vtkIdType> keys(numSeeds), bestKeys(numSeeds);
-  for (int s = 0; s < numSeeds; ++s)
-  {
-    keys[s] = hits[s].Found && hits[s].Distance2 == bestD2[s]
-      ? hits[s].Key
-      : std::numeric_limits<vtkIdType>::max();
-  }
-  ranks.AllReduce(keys.data(), bestKeys.data(), numSeeds, vtkCommunicator::MIN_OP, "a reduction");
-  std::vector<double> points(3 * numSeeds), bestPoints(3 * numSeeds);
-  for (int s = 0; s < numSeeds; ++s)
-  {
-    for (int a = 0; a < 3; ++a)
+    double bestD2 = VTK_DOUBLE_MAX;
+    for (int r = 0; r < ranks.Size; ++r)
     {
-      points[3 * s + a] =
-        hits[s].Found && hits[s].Key == bestKeys[s] ? hits[s].Point[a] : VTK_DOUBLE_MAX;
+      const double* hit = &all[5 * (numSeeds * r + s)];
+      const vtkIdType key = static_cast<vtkIdType>(hit[1]);
+      if (hit[1] >= 0 && (hit[0] < bestD2 || (hit[0] == bestD2 && key < bestKeys[s])))
+      {
+        bestD2 = hit[0];
+        bestKeys[s] = key;
+        std::copy_n(hit + 2, 3, &bestPoints[3 * s]);
+      }
     }
   }
-  ranks.AllReduce(
-    points.data(), bestPoints.data(), 3 * numSeeds, vtkCommunicator::MIN_OP, "a reduction");
   for (int s = 0; s < numSeeds; ++s)
   {
     if (bestKeys[s] == std::numeric_limits<vtkIdType>::max())
@@ -1163,6 +1193,8 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
     if (!aborted)
     {
       kernel.Extract();
+      run.trianglesMade = kernel.Mesh().NumberOfTriangles();
+      run.graph.Prepare(kernel, *run.grid, *run.own, ranks.Rank, ranks.Size);
     }
   }
   catch (const std::length_error& tooMany)
@@ -1176,14 +1208,45 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
       std::to_string(ranks.Rank) + " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) +
       " triangles so far)";
   }
-  run.trianglesMade = kernel.Mesh().NumberOfTriangles();
   run.problem = outOfMemory.empty() ? kernel.Error() : outOfMemory;
   aborted = aborted || kernel.Aborted();
-  bool missingGhosts = kernel.MissingGhosts();
-  if (!ranks.Agree(run.problem.empty(), run.problem, { &aborted, &missingGhosts }))
+  // Ports go to the neighbours that own the other cubes around them (nothing after a failure
+  // here: the exchange still runs, so that the ranks stay in step); the edges of the component
+  // graph are the ports both sides have.
+  std::vector<std::vector<vtkIdType>> nothing(ranks.Size);
+  const bool sendPorts = run.problem.empty() && !aborted;
+  const std::vector<std::vector<vtkIdType>> incoming = ranks.ExchangeInOrder(
+    sendPorts ? run.graph.PortsTo : nothing, run.own->MeetingOrder(), PortTag);
+  if (sendPorts)
+  {
+    try
+    {
+      run.graph.Join(incoming, ranks.Rank);
+    }
+    catch (const std::bad_alloc&)
+    {
+      run.problem =
+        "not enough memory to join the components on rank " + std::to_string(ranks.Rank);
+    }
+  }
+  // One agreement, which also tells every rank the sizes of every rank's part of the graph.
+  std::vector<vtkIdType> mine = { run.graph.Roots, run.graph.Edges, aborted ? 1 : 0,
+    kernel.MissingGhosts() ? 1 : 0 },
+                         all;
+  if (!ranks.AgreeGather(run.problem.empty(), run.problem, mine, all))
   {
     vtkErrorMacro(<< "Cannot extract a surface: " << run.problem << ".");
     return -1;
+  }
+  bool missingGhosts = false;
+  run.roots.resize(ranks.Size);
+  run.edges.resize(ranks.Size);
+  for (int r = 0; r < ranks.Size; ++r)
+  {
+    run.roots[r] = all[4 * r];
+    run.edges[r] = all[4 * r + 1];
+    aborted = aborted || all[4 * r + 2] != 0;
+    missingGhosts = missingGhosts || all[4 * r + 3] != 0;
   }
   if (aborted)
   {
@@ -1280,7 +1343,9 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
     {
       problem = kernel.Error();
     }
-    aborted = kernel.Aborted();
+    // An abort is noticed by the kernel's progress reports, which a rank without work makes
+    // none of: ask the filter too.
+    aborted = kernel.Aborted() || this->CheckAbort();
     if (!ranks.Agree(problem.empty(), problem, { &sending, &aborted }))
     {
       run.problem = problem;
@@ -1337,7 +1402,7 @@ bool vtkRGMarchingCubes::StoreSurface(Run& run, vtkPolyData* output)
     [&]()
     {
       const Decision& decision = run.decision;
-      const std::vector<int>& rootIndex = run.rootIndex;
+      const std::vector<int>& rootIndex = run.graph.RootIndex;
       rgmc::LocalMesh& mesh = run.kernel->Mesh();
       mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
       const vtkIdType numPoints = mesh.NumberOfPoints();

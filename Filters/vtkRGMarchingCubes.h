@@ -225,7 +225,7 @@ private:
   // that fails leaves the agreed message in the run.
   struct Run;
   bool CheckInput(Run& run, vtkImageData* input, vtkInformationVector** inputVector);
-  void AssignCubes(Run& run, vtkImageData* input);
+  void AssignCubes(Run& run);
   /// 1: every seed has a vertex; 0: no surface near a seed (warned); -1: an error.
   int FindSeeds(Run& run);
   /// 1: done; 0: aborted; -1: an error.

@@ -29,6 +29,13 @@ The threads benchmark instead: the build's rgmcThreads program, one rank, the CT
 backend that ran is recorded): vtkFlyingEdges3D, our seeded and all-components modes, Seam
 Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at every
 thread count. Writes threads.md and threads.json.
+
+  python3 Scripts/rgmc_evaluate.py --ranks-benchmark   # or: ./rgmc evaluate --ranks-benchmark
+
+The ranks benchmark instead: the build's rgmcRanks program on 1, 2 and 4 ranks (--ranks): a
+small sphere in a 3-D scaffold of rods (256^3 float), seeded on the sphere against All
+Components in the same run, and the CT phantom (512^3) seeded on the skull, with the filter's
+rounds of growth between ranks, collectives and messages. Writes ranks.md and ranks.json.
 """
 
 import argparse
@@ -424,6 +431,57 @@ def threads_report(result, args):
     return "\n".join(lines) + "\n"
 
 
+def run_ranks(args):
+    rows = []
+    for ranks in args.ranks:
+        command = rgmc_common.mpiexec_command(ranks) + [
+            args.ranks_binary, "--size", str(args.ranks_size), "--phantom", str(args.ranks_phantom),
+            "--repeats", str(args.ranks_repeats)]
+        print("+ " + " ".join(command), flush=True)
+        process = subprocess.run(command, stdout=subprocess.PIPE, text=True,
+                                 env=rgmc_common.mpi_environment())
+        if process.returncode != 0:
+            raise rgmc_common.UsageError("rgmcRanks on %d ranks failed (exit %d)" % (ranks, process.returncode))
+        for line in process.stdout.splitlines():
+            if line.startswith("{"):
+                rows.append(json.loads(line))
+                print("  " + line, flush=True)
+    return rows
+
+
+def ranks_report(rows, args):
+    cores = os.cpu_count() or 1
+    lines = ["# RGMC ranks benchmark", "",
+             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
+             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+             "A run's time is its slowest rank's, the minimum of %d runs; each rank computes its own "
+             "block of the volume. Rounds: of seeded growth between ranks; collectives: per rank; "
+             "messages: the most a rank sent (sizes and data). Ranks above %d cores are "
+             "oversubscribed (*)." % (args.ranks_repeats, cores), "",
+             "## A small sphere in a scaffold of rods (%d^3 float), seeded on the sphere" % args.ranks_size, "",
+             "| ranks | seeded (s) | all components (s) | seeded / all | seeded triangles | all triangles "
+             "| rounds | collectives | messages |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in [r for r in rows if r["case"] == "scaffold"]:
+        lines.append("| %d%s | %.4f | %.3f | %.4f | %d | %d | %d | %d | %d |" % (
+            r["ranks"], "*" if r["ranks"] > cores else "", r["seeded"], r["all"], r["seeded_over_all"],
+            r["seeded_triangles"], r["all_triangles"], r["seeded_rounds"], r["seeded_collectives"],
+            r["seeded_most_messages"]))
+    lines += ["", "## The CT phantom (%d^3), seeded on the skull" % args.ranks_phantom, "",
+              "| ranks | seeded (s) | triangles | rounds | collectives | messages |",
+              "|---|---|---|---|---|---|"]
+    for r in [r for r in rows if r["case"] == "phantom"]:
+        lines.append("| %d%s | %.3f | %d | %d | %d | %d |" % (
+            r["ranks"], "*" if r["ranks"] > cores else "", r["seeded"], r["seeded_triangles"],
+            r["seeded_rounds"], r["seeded_collectives"], r["seeded_most_messages"]))
+    four = [r for r in rows if r["case"] == "scaffold" and r["ranks"] == 4]
+    if four:
+        ratio = four[0]["seeded_over_all"]
+        lines += ["", "Target (issue 15): seeded <= 0.05x All Components at 4 ranks: %.4fx, %s." % (
+            ratio, "met" if ratio <= 0.05 else "NOT met")]
+    return "\n".join(lines) + "\n"
+
+
 def main(argv):
     parser = argparse.ArgumentParser(prog="rgmc_evaluate.py", description=__doc__.split("\n")[0])
     parser.add_argument("--cases", default="phantom256,phantom512,sphere512,blobs,mri")
@@ -449,6 +507,12 @@ def main(argv):
     parser.add_argument("--threads-repeats", type=int, default=3)
     parser.add_argument("--backend", default="STDThread", help="the vtkSMPTools backend of --threads")
     parser.add_argument("--threads-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcThreads"))
+    parser.add_argument("--ranks-benchmark", action="store_true",
+                        help="the ranks benchmark instead (rgmcRanks on --ranks, default 1,2,4)")
+    parser.add_argument("--ranks-size", type=int, default=256, help="the scaffold's points per axis")
+    parser.add_argument("--ranks-phantom", type=int, default=512, help="the phantom's points per axis (0: none)")
+    parser.add_argument("--ranks-repeats", type=int, default=4)
+    parser.add_argument("--ranks-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcRanks"))
     parser.add_argument("--report-only", action="store_true",
                         help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)
@@ -466,6 +530,19 @@ def main(argv):
             out.write(text)
         print("\n" + text)
         print("written: %s" % os.path.join(args.output, "threads.md"))
+        return 0
+    if args.ranks_benchmark:
+        if not os.path.isfile(args.ranks_binary):
+            raise rgmc_common.UsageError("no ranks program at %s: build first (./rgmc build)" % args.ranks_binary)
+        os.makedirs(args.output, exist_ok=True)
+        rows = run_ranks(args)
+        with open(os.path.join(args.output, "ranks.json"), "w") as out:
+            json.dump(rows, out, indent=1)
+        text = ranks_report(rows, args)
+        with open(os.path.join(args.output, "ranks.md"), "w") as out:
+            out.write(text)
+        print("\n" + text)
+        print("written: %s" % os.path.join(args.output, "ranks.md"))
         return 0
     if args.scale:
         if not os.path.isfile(args.scale_binary):

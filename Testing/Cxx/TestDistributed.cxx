@@ -180,13 +180,22 @@ void CollectiveErrors(vtkMultiProcessController* controller)
       Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::SEEDED, { { 16, 16, 90 } }),
       "lies outside the volume", false);
   }
-  // An abort on the last rank only: every rank stops with an empty output.
+  // An abort on the last rank only: every rank stops with an empty output, in the full scan
+  // and in seeded growth, here of a small ball inside rank 0's block that the last rank never
+  // reaches (so its kernel reports no progress).
+  const Field ball = IndexField("ball", VTK_FLOAT,
+    [](int i, int j, int k) {
+      return 3.0 - std::sqrt((i - 5.0) * (i - 5.0) + (j - 5.0) * (j - 5.0) + (k - 5.0) * (k - 5.0));
+    },
+    0.0, { { { 5.0, 5.0, 8.0 } } });
+  for (const int mode : { vtkRGMarchingCubes::ALL_COMPONENTS, vtkRGMarchingCubes::SEEDED })
   {
-    vtkSmartPointer<vtkImageData> image = MakePiece(field.Make, Whole, piece);
+    vtkSmartPointer<vtkImageData> image = MakePiece(ball.Make, Whole, piece);
     vtkNew<vtkCallbackCommand> abort;
     abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*)
       { static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1); });
-    const Run r = Extract(controller, image, field.Isovalue, vtkRGMarchingCubes::ALL_COMPONENTS, {},
+    const Run r = Extract(controller, image, ball.Isovalue, mode,
+      mode == vtkRGMarchingCubes::SEEDED ? ball.SeedSets[0] : Seeds(),
       [&](vtkRGMarchingCubes* rg)
       {
         if (rank == ranks - 1)
@@ -195,7 +204,7 @@ void CollectiveErrors(vtkMultiProcessController* controller)
         }
       });
     RGMC_CHECK(r.Output->GetNumberOfCells() == 0,
-      "abort on the last rank (rank " << rank << "): output not empty");
+      "abort on the last rank (rank " << rank << ", mode " << mode << "): output not empty");
   }
 }
 
