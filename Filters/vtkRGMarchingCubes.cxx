@@ -60,6 +60,10 @@ namespace
 using rgmc::Ranks;
 constexpr int PortTag = 48731;
 constexpr int DepartureTag = 48741;
+// Seeded growth on several ranks pauses after expanding this many surface nodes (about 10 ms
+// of work) to hand what reached the neighbours' parts on to them: so that the ranks a large
+// structure passes through grow it at the same time rather than one after the other.
+constexpr std::int64_t GrowthBudget = std::int64_t(1) << 16;
 
 const rgmc::CaseTable& Cases()
 {
@@ -268,6 +272,9 @@ public:
   virtual bool Aborted() const = 0;
   virtual bool MissingGhosts() const = 0;
   virtual void SetCrossRanks(bool cross) = 0;
+  virtual void SetBudget(std::int64_t budget) = 0;
+  virtual bool Busy() const = 0;
+  virtual void Continue() = 0;
   virtual std::vector<rgmc::Departure> TakeDepartures() = 0;
   virtual void GrowFromArrivals(const std::vector<rgmc::Arrival>& arrivals, int numLabels) = 0;
   virtual std::int64_t CubesExamined() const = 0;
@@ -300,6 +307,9 @@ public:
   bool Aborted() const override { return this->Kernel.Aborted(); }
   bool MissingGhosts() const override { return this->Kernel.MissingGhosts(); }
   void SetCrossRanks(bool cross) override { this->Kernel.SetCrossRanks(cross); }
+  void SetBudget(std::int64_t budget) override { this->Kernel.SetBudget(budget); }
+  bool Busy() const override { return this->Kernel.Busy(); }
+  void Continue() override { this->Kernel.Continue(); }
   std::vector<rgmc::Departure> TakeDepartures() override { return this->Kernel.TakeDepartures(); }
   void GrowFromArrivals(const std::vector<rgmc::Arrival>& arrivals, int numLabels) override
   {
@@ -729,8 +739,9 @@ struct vtkRGMarchingCubes::Run
 // The collective schedule: every rank runs these passes in this order and makes the same
 // collective calls in each (an agreement is one collective call on success, one or two
 // broadcasts more on failure); a pass that fails returns on every rank at the same point.
-// Seeded on N ranks with R rounds of growth between ranks: 9 + R collective calls on success
-// and R + 1 exchanges with the neighbours; Largest and All: 8 and 1.
+// Seeded on N ranks with R rounds of growth with messages between ranks and G rounds without
+// (a rank still growing past its budget): 9 + R + G collective calls on success and R + 1
+// exchanges with the neighbours; Largest and All: 8 and 1.
 //
 //  PASS 0 CheckInput       AllReduce (whole extent), agreement gathering every rank's boxes
 //                          of cells, whether it has points, and its geometry
@@ -1265,9 +1276,10 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
 // cubes around them. Each round then: the departures (vertices where growth stepped into
 // another rank's cubes) go to those cubes' owners, once per vertex and owner, except back to
 // the rank a vertex just came from; one reduction agrees on the status and on whether anybody
-// sent anything; if so, the neighbours exchange departures and each rank grows on from what it
-// received (one new component per sending rank's component). A rank the structure never
-// reaches examines no cube. Past MaximumGrowthRounds every rank grows the rest in one step.
+// sent anything (or has growth left); if so, the neighbours exchange departures and each rank
+// grows on from what it received (one new component per sending rank's component), for at most
+// GrowthBudget nodes. A rank the structure never reaches examines no cube. Past
+// MaximumGrowthRounds rounds with messages every rank grows the rest in one step.
 bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
 {
   Ranks& ranks = run.ranks;
@@ -1297,6 +1309,7 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
     }
   };
   kernel.SetCrossRanks(true);
+  kernel.SetBudget(GrowthBudget);
   local("grow from the seeds",
     [&]()
     {
@@ -1346,14 +1359,21 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
     // An abort is noticed by the kernel's progress reports, which a rank without work makes
     // none of: ask the filter too.
     aborted = kernel.Aborted() || this->CheckAbort();
-    if (!ranks.Agree(problem.empty(), problem, { &sending, &aborted }))
+    bool busy = kernel.Busy();
+    if (!ranks.Agree(problem.empty(), problem, { &sending, &aborted, &busy }))
     {
       run.problem = problem;
       return false;
     }
-    if (!sending || aborted)
+    if (aborted || (!sending && !busy))
     {
       return true;
+    }
+    if (!sending)
+    {
+      // Some rank still grows a large part of the structure: a round without messages.
+      local("grow the surface", [&]() { kernel.Continue(); });
+      continue;
     }
     if (run.rounds >= this->MaximumGrowthRounds)
     {
@@ -1361,7 +1381,13 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
       // those joined to a seed. The departures not sent are among them.
       run.oneStep = true;
       kernel.SetCrossRanks(false);
-      local("grow the components at the shared faces", [&]() { kernel.GrowBoundary(); });
+      kernel.SetBudget(std::numeric_limits<std::int64_t>::max());
+      local("grow the components at the shared faces",
+        [&]()
+        {
+          kernel.Continue();
+          kernel.GrowBoundary();
+        });
       return true; // GrowAndExtract agrees on the status
     }
     const std::vector<std::vector<vtkIdType>> incoming =

@@ -45,8 +45,10 @@
  *    the global one (ties: smallest key).
  * 3. Growth. Seeded: the ranks that own cubes around a seed vertex grow from it; a step into a
  *    cube of another rank becomes a departure (the vertex and its component), sent to that
- *    cube's owner, which grows on from it in the next round. Rounds end when a reduction says no
- *    rank sent anything: a rank the structure never reaches reads no cube. After
+ *    cube's owner, which grows on from it in the next round. A rank grows at most 65 536
+ *    nodes per round, so that its neighbours get their part early and grow at the same time.
+ *    Rounds end when a reduction says no rank sent anything or has growth left: a rank the
+ *    structure never reaches reads no cube. After
  *    MaximumGrowthRounds rounds (a structure that crosses between ranks very often) the rest
  *    is grown in one step instead: every rank grows every component next to another rank's
  *    cubes, and step 4 keeps those joined to a seed. Largest and All: every rank scans all its

@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -89,6 +90,16 @@ public:
     return taken;
   }
 
+  /// Growth from seeds and arrivals stops after expanding about `budget` nodes (at the end of a
+  /// round of tiles) and goes on at the next call of Continue: so a rank can hand departures
+  /// to its neighbours while its part of a large structure is still growing. Unlimited by
+  /// default.
+  void SetBudget(std::int64_t budget) { this->Budget = budget; }
+  /// Whether growth stopped on its budget with work left.
+  bool Busy() const { return !this->Pending.empty(); }
+  /// Goes on with the work left (another budget's worth).
+  void Continue() { this->Rounds({}); }
+
   /// How many grid points of the faces shared with other ranks GrowBoundary read.
   std::int64_t PlanePointsRead() const { return this->PlanePoints; }
 
@@ -108,8 +119,13 @@ public:
   /// use the arrival's vertex and were not found yet. Arrivals are taken in the order given.
   void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels)
   {
-    if (this->Work.empty() || arrivals.empty())
+    if (this->Work.empty())
     {
+      return;
+    }
+    if (arrivals.empty())
+    {
+      this->Rounds({}); // the work left pending, if any
       return;
     }
     const int first = this->Components.Size();
@@ -474,12 +490,27 @@ private:
     return comp;
   }
 
-  /// Searches the active tiles (sorted; their queues hold the nodes found so far) in rounds
-  /// until no crossing is left, appending the nodes found to Found.
+  /// Searches the active tiles (sorted; their queues hold the nodes found so far), with the
+  /// tiles left pending by an earlier call, in rounds until no crossing is left or Budget nodes
+  /// were expanded in this call (then the tiles with crossings stay pending), appending the
+  /// nodes found to Found.
   void Rounds(std::vector<std::int64_t> active)
   {
+    if (!this->Pending.empty())
+    {
+      active.insert(active.end(), this->Pending.begin(), this->Pending.end());
+      std::sort(active.begin(), active.end());
+      active.erase(std::unique(active.begin(), active.end()), active.end());
+      this->Pending.clear();
+    }
+    const std::int64_t start = this->NodesExpanded;
     while (!active.empty() && !this->Volume.Stopped())
     {
+      if (this->NodesExpanded - start >= this->Budget)
+      {
+        this->Pending.swap(active); // the rest in a later call
+        return;
+      }
       this->Volume.Parallel(static_cast<std::int64_t>(active.size()),
         [&](std::int64_t n)
         {
@@ -680,6 +711,8 @@ private:
   std::vector<TileWork> Work;          // per tile
   std::vector<SurfaceNode> Found;
   std::vector<Departure> Departures;
+  std::vector<std::int64_t> Pending; // tiles with crossings left by the budget, sorted
+  std::int64_t Budget = std::numeric_limits<std::int64_t>::max();
   std::int64_t NodesExpanded = 0;
   std::int64_t ScannedCubes = 0; // cubes read by ScanRegion
   std::int64_t PlanePoints = 0;  // grid points read by GrowFromPlane

@@ -43,6 +43,9 @@ public:
   void GrowAll() { this->Growth.GrowAll(); }
   void GrowBoundary() { this->Growth.GrowBoundary(); }
   void SetCrossRanks(bool cross) { this->Growth.CrossRanks = cross; }
+  void SetBudget(std::int64_t budget) { this->Growth.SetBudget(budget); }
+  bool Busy() const { return this->Growth.Busy(); }
+  void Continue() { this->Growth.Continue(); }
   std::vector<Departure> TakeDepartures() { return this->Growth.TakeDepartures(); }
   void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels)
   {
