@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 #include <vector>
 
@@ -264,6 +265,132 @@ void SplitOwnership()
   RGMC_CHECK(!portSides.empty(), "the surface crosses the plane, so there are ports");
 }
 
+/// Seeded growth between owners in rounds, as vtkRGMarchingCubes runs it between ranks (with a
+/// tiny budget, so that growth pauses and goes on): the owners' union equals the component grown
+/// by one owner, whatever the budget, and an owner the component never reaches reads nothing.
+void RoundsBetweenOwners()
+{
+  Volume vol(16, 70, 8); // 69 cells along y: 3 tiles of 32, so growth pauses between them
+  for (int k = 0; k <= 7; ++k)
+  {
+    for (int j = 0; j <= 69; ++j)
+    {
+      for (int i = 0; i <= 15; ++i)
+      {
+        // A tube of radius 1.5 along y inside owner 1's cells (x = 5) that bends into owner
+        // 2's at its far end (x = 9 from y = 65): owners 0 and 3 hold no surface, and owner 2
+        // is reached only after owner 1 grew the tube through its 3 tiles.
+        const double x = i - 5.0 - std::min(4.0, 0.4 * std::max(0, j - 55)), z = k - 3.5;
+        vol.At(i, j, k) = static_cast<float>(1.5 - std::sqrt(x * x + z * z));
+      }
+    }
+  }
+  const rgmc::Grid grid(vol.Extent, vol.Extent);
+  rgmc::SurfaceOptions params;
+  params.Isovalue = 0.2;
+  // The seed: the first edge along x in owner 1's cells that the surface crosses.
+  std::int64_t seed = -1;
+  for (int k = 0; k <= 7 && seed < 0; ++k)
+  {
+    for (int j = 0; j <= 69 && seed < 0; ++j)
+    {
+      for (int i = 3; i < 6 && seed < 0; ++i)
+      {
+        if ((vol.At(i, j, k) >= 0.2f) != (vol.At(i + 1, j, k) >= 0.2f))
+        {
+          seed = grid.EdgeKey(i, j, k, 0);
+        }
+      }
+    }
+  }
+  std::vector<rgmc::CellBox> boxes(4, grid.WholeCells());
+  boxes[0].Hi[0] = 2;
+  boxes[1].Lo[0] = 3;
+  boxes[1].Hi[0] = 6;
+  boxes[2].Lo[0] = 7;
+  boxes[2].Hi[0] = 11;
+  boxes[3].Lo[0] = 12;
+  const rgmc::Ownership one = OwnAll(grid);
+  rgmc::SurfaceKernel<std::vector<float>> whole(Table(), grid, one, vol.Values, params);
+  RGMC_CHECK(whole.GrowFromKey(seed) >= 0, "the seed key is on the surface");
+  whole.Extract();
+  const std::set<Triangle> expected = KeyTriangles(whole.Mesh());
+  for (const std::int64_t budget : { std::int64_t(1), std::int64_t(7), std::int64_t(1) << 40 })
+  {
+    std::vector<rgmc::Ownership> owners;
+    std::vector<std::unique_ptr<rgmc::SurfaceKernel<std::vector<float>>>> kernels;
+    for (int r = 0; r < 4; ++r)
+    {
+      owners.emplace_back(boxes, r);
+    }
+    for (int r = 0; r < 4; ++r)
+    {
+      kernels.emplace_back(
+        new rgmc::SurfaceKernel<std::vector<float>>(Table(), grid, owners[r], vol.Values, params));
+      kernels[r]->SetCrossRanks(true);
+      kernels[r]->SetBudget(budget);
+      kernels[r]->GrowFromKey(seed);
+    }
+    int rounds = 0;
+    for (bool more = true; more && rounds < 10000; ++rounds)
+    {
+      // Departures to the owners of the other cubes around their vertices.
+      std::vector<std::vector<rgmc::Arrival>> inbox(4);
+      std::vector<int> labels(4, 0);
+      more = false;
+      for (int r = 0; r < 4; ++r)
+      {
+        more = more || kernels[r]->Busy();
+        for (const rgmc::Departure& d : kernels[r]->TakeDepartures())
+        {
+          int p[3], axis;
+          grid.Decode(d.Key, p, axis);
+          std::set<int> to;
+          rgmc::ForCubesAround(p, axis,
+            [&](int i, int j, int k, int)
+            {
+              const int owner = owners[r].OwnerNear(i, j, k);
+              if (grid.HasCell(i, j, k) && owner >= 0 && owner != r)
+              {
+                to.insert(owner);
+              }
+            });
+          for (const int q : to)
+          {
+            inbox[q].push_back(rgmc::Arrival{ d.Key, labels[q]++ });
+            more = true;
+          }
+        }
+      }
+      for (int r = 0; r < 4; ++r)
+      {
+        kernels[r]->GrowFromArrivals(inbox[r], labels[r]);
+      }
+    }
+    std::set<Triangle> united;
+    for (int r = 0; r < 4; ++r)
+    {
+      kernels[r]->Extract();
+      for (const Triangle& t : KeyTriangles(kernels[r]->Mesh()))
+      {
+        RGMC_CHECK(united.insert(t).second, "budget " << budget << ": a triangle made twice");
+      }
+    }
+    RGMC_CHECK(united == expected,
+      "budget " << budget << ": the owners' union differs from one "
+                << "owner's: " << united.size() << " vs " << expected.size() << " triangles");
+    RGMC_CHECK(
+      rounds > 2, "budget " << budget << ": the surface crossed in " << rounds << " rounds");
+    for (const int r : { 0, 3 })
+    {
+      RGMC_CHECK(kernels[r]->CubesExamined() == 0,
+        "budget " << budget << ": owner " << r << ", without surface, examined "
+                  << kernels[r]->CubesExamined() << " cubes");
+    }
+    RGMC_CHECK(kernels[2]->CubesExamined() > 0, "budget " << budget << ": owner 2 grew nothing");
+  }
+}
+
 /// Seeded growth reads the same samples for the same surface, however large the volume.
 void CostFollowsSurface()
 {
@@ -352,6 +479,7 @@ int main()
   TwoBlobs();
   SampleEqualsIsovalue();
   SplitOwnership();
+  RoundsBetweenOwners();
   CostFollowsSurface();
   TraversalIsComplete();
   return rgmc_test::Result("TestGrowth");
