@@ -34,7 +34,7 @@ thread count. Writes threads.md and threads.json.
 
 The ranks benchmark instead: the build's rgmcRanks program on 1, 2 and 4 ranks (--ranks): a
 small sphere in a 3-D scaffold of rods (256^3 float), seeded on the sphere against All
-Components in the same run, and the CT phantom (512^3) seeded on the skull, with the filter's
+Components in the same run, seeded on a rod (the scaffold as the chosen structure), and the CT phantom (512^3) seeded on the skull, with the filter's
 rounds of growth between ranks, collectives and messages. Writes ranks.md and ranks.json.
 """
 
@@ -460,13 +460,17 @@ def ranks_report(rows, args):
              "oversubscribed (*)." % (args.ranks_repeats, cores), "",
              "## A small sphere in a scaffold of rods (%d^3 float), seeded on the sphere" % args.ranks_size, "",
              "| ranks | seeded (s) | all components (s) | seeded / all | seeded triangles | all triangles "
-             "| rounds | collectives | messages |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| rounds | collectives | messages | seeded on a rod (s) | rod's rounds |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in [r for r in rows if r["case"] == "scaffold"]:
-        lines.append("| %d%s | %.4f | %.3f | %.4f | %d | %d | %d | %d | %d |" % (
+        lines.append("| %d%s | %.4f | %.3f | %.4f | %d | %d | %d | %d | %d | %.3f | %d |" % (
             r["ranks"], "*" if r["ranks"] > cores else "", r["seeded"], r["all"], r["seeded_over_all"],
             r["seeded_triangles"], r["all_triangles"], r["seeded_rounds"], r["seeded_collectives"],
-            r["seeded_most_messages"]))
+            r["seeded_most_messages"], r["seeded_rods"], r["seeded_rods_rounds"]))
+    scaffold = [r for r in rows if r["case"] == "scaffold"]
+    if scaffold:
+        lines += ["", "Seeded on a rod: the scaffold itself is the chosen structure (%d triangles), "
+                  "every rank holds part of it." % scaffold[0]["seeded_rods_triangles"]]
     lines += ["", "## The CT phantom (%d^3), seeded on the skull" % args.ranks_phantom, "",
               "| ranks | seeded (s) | triangles | rounds | collectives | messages |",
               "|---|---|---|---|---|---|"]
