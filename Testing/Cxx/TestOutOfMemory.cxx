@@ -6,7 +6,9 @@
 // For each stage in turn, the limit is set when the stage starts, from just above the memory in
 // use to more than the stage needs, so that allocations fail at different points of each stage
 // (the test prints which stage failed at each limit, and requires a failure in every stage and a
-// complete run once the limit is high enough). Not built with the sanitizers: AddressSanitizer
+// complete run once the limit is high enough). With --seeded, the extraction runs in Seeded mode
+// (its growth in rounds between the ranks) and only its stage is swept. Not built with the
+// sanitizers: AddressSanitizer
 // reserves terabytes of address space, so an address-space limit cannot work there.
 #include "rgmcCheck.h"
 #include "rgmcDistributedData.h" // GyroidPiece, SameOnAllRanks
@@ -53,7 +55,7 @@ struct Run
 /// Runs the job; the last rank's address space is limited from the start of stage `limitStage`
 /// (0: never) to `headroom` bytes beyond what it uses then.
 Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const std::string& file,
-  int limitStage = 0, long long headroom = 0)
+  bool seeded, int limitStage = 0, long long headroom = 0)
 {
   const int ranks = controller->GetNumberOfProcesses();
   const bool limited = controller->GetLocalProcessId() == ranks - 1;
@@ -134,7 +136,15 @@ Run RunJob(vtkMultiProcessController* controller, vtkImageData* volume, const st
   extract->SetController(controller);
   extract->SetInputData(volume);
   extract->SetIsovalue(0.0);
-  extract->SetExtractionMode(vtkRGMarchingCubes::ALL_COMPONENTS);
+  if (seeded)
+  {
+    extract->SetExtractionMode(vtkRGMarchingCubes::SEEDED);
+    extract->AddSeedPoint(48.3, 48.1, 47.9);
+  }
+  else
+  {
+    extract->SetExtractionMode(vtkRGMarchingCubes::ALL_COMPONENTS);
+  }
   limit(1);
   extract->Update();
   run.Cells = extract->GetOutput()->GetNumberOfCells();
@@ -188,14 +198,20 @@ int main(int argc, char* argv[])
   mallopt(M_TRIM_THRESHOLD, 128 * 1024);
   vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
-  const std::string file = "TestOutOfMemory-" + std::to_string(ranks) + ".ply";
+  bool seeded = false;
+  for (int a = 1; a < argc; ++a)
+  {
+    seeded = seeded || std::string(argv[a]) == "--seeded";
+  }
+  const std::string file =
+    "TestOutOfMemory-" + std::string(seeded ? "seeded-" : "") + std::to_string(ranks) + ".ply";
 
   // This rank's piece of a gyroid (one surface through the whole volume, on every seam).
   vtkSmartPointer<vtkImageData> volume = rgmc_test::GyroidPiece(96, 12.0, rank, ranks);
 
   // The unlimited run: the expected result, and how much address space each stage needs.
   const long long base = StatusBytes("VmSize:");
-  const Run reference = RunJob(controller, volume, file);
+  const Run reference = RunJob(controller, volume, file, seeded);
   RGMC_CHECK(reference.FailedStage == 0 && reference.File && reference.Triangles > 0,
     "the unlimited run failed: " << reference.Errors);
   ::unlink(file.c_str());
@@ -210,12 +226,12 @@ int main(int argc, char* argv[])
 
   // The sweep: from each stage on, the last rank may grow by `headroom` beyond what it uses when
   // the stage starts.
-  for (int stage = 1; stage <= 3; ++stage)
+  for (int stage = 1; stage <= (seeded ? 1 : 3); ++stage)
   {
     int failedHere = 0, complete = 0;
     for (long long headroom = 0; !complete; headroom = headroom ? headroom * 3 / 2 : 256 << 10)
     {
-      const Run run = RunJob(controller, volume, file, stage, headroom);
+      const Run run = RunJob(controller, volume, file, seeded, stage, headroom);
       if (rank == 0)
       {
         std::cout << "limit from stage " << stage << ", headroom " << (headroom >> 10) << " KiB: "
@@ -260,5 +276,5 @@ int main(int argc, char* argv[])
     }
     RGMC_CHECK(failedHere > 0, "no allocation failed in stage " << stage);
   }
-  return rgmc_test::Finish(controller, "TestOutOfMemory");
+  return rgmc_test::Finish(controller, seeded ? "TestOutOfMemory --seeded" : "TestOutOfMemory");
 }
