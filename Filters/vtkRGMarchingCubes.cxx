@@ -741,7 +741,7 @@ struct vtkRGMarchingCubes::Run
 // broadcasts more on failure); a pass that fails returns on every rank at the same point.
 // Seeded on N ranks with R rounds of growth with messages between ranks and G rounds without
 // (a rank still growing past its budget): 9 + R + G collective calls on success and R + 1
-// exchanges with the neighbours; Largest and All: 8 and 1.
+// exchanges with the neighbours (on one rank: 8 calls); Largest and All: 7 and 1.
 //
 //  PASS 0 CheckInput       AllReduce (whole extent), agreement gathering every rank's boxes
 //                          of cells, whether it has points, and its geometry
