@@ -33,37 +33,20 @@ namespace
 
 using rgmc_benchmark::Now;
 
-/// The filter's counts when it has them (this version), else -1 (older versions).
-template <typename F>
-auto Rounds(F* f, int) -> decltype(static_cast<long long>(f->GetNumberOfGrowthRounds()))
+/// One of the filter's counts when this version has it (`get` names it), else -1 (older versions).
+template <typename F, typename Get>
+auto Count(F* f, Get get, int) -> decltype(static_cast<long long>(get(f)))
 {
-  return f->GetNumberOfGrowthRounds();
+  return get(f);
 }
-template <typename F>
-long long Rounds(F*, long)
-{
-  return -1;
-}
-template <typename F>
-auto Collectives(F* f, int) -> decltype(static_cast<long long>(f->GetNumberOfCollectives()))
-{
-  return f->GetNumberOfCollectives();
-}
-template <typename F>
-long long Collectives(F*, long)
+template <typename F, typename Get>
+long long Count(F*, Get, long)
 {
   return -1;
 }
-template <typename F>
-auto Messages(F* f, int) -> decltype(static_cast<long long>(f->GetNumberOfMessages()))
-{
-  return f->GetNumberOfMessages();
-}
-template <typename F>
-long long Messages(F*, long)
-{
-  return -1;
-}
+#define RGMC_COUNT(filter, method)                                                                 \
+  Count(                                                                                           \
+    filter, [](auto* f) -> decltype(f->method()) { return f->method(); }, 0)
 
 /// The sphere-in-a-scaffold field over `size`^3 points: rods of radius 2.5 along each axis on
 /// a lattice of pitch size/8 (offset by a quarter pitch), and a sphere of radius 5 in the middle
@@ -128,11 +111,12 @@ Timing Time(vtkMultiProcessController* c, vtkImageData* piece, double isovalue, 
     c->AllReduce(&seconds, &slowest, 1, vtkCommunicator::MAX_OP);
     t.Seconds = std::min(t.Seconds, slowest);
   }
-  long long mine = rg->GetOutput()->GetNumberOfCells(), messages = Messages(rg.Get(), 0);
+  long long mine = rg->GetOutput()->GetNumberOfCells(),
+            messages = RGMC_COUNT(rg.Get(), GetNumberOfMessages);
   c->AllReduce(&mine, &t.Triangles, 1, vtkCommunicator::SUM_OP);
   c->AllReduce(&messages, &t.MostMessages, 1, vtkCommunicator::MAX_OP);
-  t.Rounds = Rounds(rg.Get(), 0);
-  t.Collectives = Collectives(rg.Get(), 0);
+  t.Rounds = RGMC_COUNT(rg.Get(), GetNumberOfGrowthRounds);
+  t.Collectives = RGMC_COUNT(rg.Get(), GetNumberOfCollectives);
   return t;
 }
 

@@ -486,6 +486,18 @@ def ranks_report(rows, args):
     return "\n".join(lines) + "\n"
 
 
+def write_results(folder, name, results, text):
+    """Writes <name>.json and <name>.md (the report `text`) into `folder` and prints the report."""
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, name + ".json"), "w") as out:
+        json.dump(results, out, indent=1)
+    with open(os.path.join(folder, name + ".md"), "w") as out:
+        out.write(text)
+    print("\n" + text)
+    print("written: %s" % os.path.join(folder, name + ".md"))
+    return 0
+
+
 def main(argv):
     parser = argparse.ArgumentParser(prog="rgmc_evaluate.py", description=__doc__.split("\n")[0])
     parser.add_argument("--cases", default="phantom256,phantom512,sphere512,blobs,mri")
@@ -525,42 +537,18 @@ def main(argv):
     if args.threads:
         if not os.path.isfile(args.threads_binary):
             raise rgmc_common.UsageError("no threads program at %s: build first (./rgmc build)" % args.threads_binary)
-        os.makedirs(args.output, exist_ok=True)
         result = run_threads(args)
-        with open(os.path.join(args.output, "threads.json"), "w") as out:
-            json.dump(result, out, indent=1)
-        text = threads_report(result, args)
-        with open(os.path.join(args.output, "threads.md"), "w") as out:
-            out.write(text)
-        print("\n" + text)
-        print("written: %s" % os.path.join(args.output, "threads.md"))
-        return 0
+        return write_results(args.output, "threads", result, threads_report(result, args))
     if args.ranks_benchmark:
         if not os.path.isfile(args.ranks_binary):
             raise rgmc_common.UsageError("no ranks program at %s: build first (./rgmc build)" % args.ranks_binary)
-        os.makedirs(args.output, exist_ok=True)
         rows = run_ranks(args)
-        with open(os.path.join(args.output, "ranks.json"), "w") as out:
-            json.dump(rows, out, indent=1)
-        text = ranks_report(rows, args)
-        with open(os.path.join(args.output, "ranks.md"), "w") as out:
-            out.write(text)
-        print("\n" + text)
-        print("written: %s" % os.path.join(args.output, "ranks.md"))
-        return 0
+        return write_results(args.output, "ranks", rows, ranks_report(rows, args))
     if args.scale:
         if not os.path.isfile(args.scale_binary):
             raise rgmc_common.UsageError("no scale program at %s: build first (./rgmc build)" % args.scale_binary)
-        os.makedirs(args.output, exist_ok=True)
         rows = run_scale(args)
-        with open(os.path.join(args.output, "scale.json"), "w") as out:
-            json.dump(rows, out, indent=1)
-        text = scale_report(rows, args)
-        with open(os.path.join(args.output, "scale.md"), "w") as out:
-            out.write(text)
-        print("\n" + text)
-        print("written: %s" % os.path.join(args.output, "scale.md"))
-        return 0
+        return write_results(args.output, "scale", rows, scale_report(rows, args))
     args.sweep = [int(n) for n in args.sweep.split(",") if n]
     if not args.report_only and not os.path.isfile(args.binary):
         raise rgmc_common.UsageError("no evaluation program at %s: build first (./rgmc build)" % args.binary)

@@ -134,30 +134,14 @@ public:
       this->Components.Add(true);
     }
     std::vector<std::int64_t> active;
-    std::vector<char> isActive(this->Work.size(), 0);
     for (const Arrival& a : arrivals)
     {
       int p[3], axis;
       this->Volume.GridOf.Decode(a.Key, p, axis);
-      ForCubesAround(p, axis,
-        [&](int i, int j, int k, int edge)
-        {
-          if (!this->Volume.Owned.Owns(i, j, k))
-          {
-            return;
-          }
-          const std::int64_t tile = this->TileOf(i, j, k);
-          TileWork& w = this->Work[tile];
-          const std::size_t before = w.Queue.size();
-          this->Visit(w, i, j, k, a.Key, edge, first + a.Label, nullptr);
-          if (w.Queue.size() > before && !isActive[tile])
-          {
-            isActive[tile] = 1;
-            active.push_back(tile);
-          }
-        });
+      this->VisitAround(a.Key, p, axis, first + a.Label, nullptr, active);
     }
     std::sort(active.begin(), active.end());
+    active.erase(std::unique(active.begin(), active.end()), active.end());
     this->Rounds(active);
   }
 
@@ -448,18 +432,12 @@ private:
     }
   }
 
-  /// Grows, as a new component, from the nodes that use vertex `key` (at grid point p; axis < 0
-  /// for a grid-point key) unless they were all found; rounds until no tile has work. Returns
-  /// the component, or -1 when nothing new was found (`seen` says whether it was found before).
-  int GrowFrom(std::int64_t key, const int p[3], int axis, bool seeded, bool* seen)
+  /// Visits, for component `comp`, the owned cubes around vertex `key` (at grid point p; axis
+  /// < 0 for a grid-point key); appends to `active` each tile whose queue grew (duplicates
+  /// possible).
+  void VisitAround(std::int64_t key, const int p[3], int axis, int comp, bool* seen,
+    std::vector<std::int64_t>& active)
   {
-    if (this->Work.empty())
-    {
-      return -1;
-    }
-    const int comp = this->Components.Add(seeded);
-    std::vector<std::int64_t> active;
-    bool any = false;
     ForCubesAround(p, axis,
       [&](int i, int j, int k, int edge)
       {
@@ -473,19 +451,31 @@ private:
         this->Visit(w, i, j, k, key, edge, comp, seen);
         if (w.Queue.size() > before)
         {
-          any = true;
-          if (std::find(active.begin(), active.end(), tile) == active.end())
-          {
-            active.push_back(tile);
-          }
+          active.push_back(tile);
         }
       });
+  }
+
+  /// Grows, as a new component, from the nodes that use vertex `key` (at grid point p; axis < 0
+  /// for a grid-point key) unless they were all found; rounds until no tile has work. Returns
+  /// the component, or -1 when nothing new was found (`seen` says whether it was found before).
+  int GrowFrom(std::int64_t key, const int p[3], int axis, bool seeded, bool* seen)
+  {
+    if (this->Work.empty())
+    {
+      return -1;
+    }
+    const int comp = this->Components.Add(seeded);
+    std::vector<std::int64_t> active;
+    this->VisitAround(key, p, axis, comp, seen, active);
+    const bool any = !active.empty();
     if (!any)
     {
       this->Components.RemoveLast();
       return -1;
     }
     std::sort(active.begin(), active.end());
+    active.erase(std::unique(active.begin(), active.end()), active.end());
     this->Rounds(active);
     return comp;
   }
