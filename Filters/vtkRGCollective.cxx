@@ -8,9 +8,9 @@ namespace rgmc
 {
 
 Ranks::Ranks(vtkMultiProcessController* controller)
-  : C(controller)
-  , Rank(controller->GetLocalProcessId())
+  : Rank(controller->GetLocalProcessId())
   , Size(controller->GetNumberOfProcesses())
+  , C(controller)
 {
   // Room to drain a message that finds no memory, reserved now: not touched (so it costs no
   // memory) unless it is needed, when allocating it could fail too.

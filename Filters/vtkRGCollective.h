@@ -142,6 +142,13 @@ public:
     this->Check(this->C->Broadcast(values, n, root), what);
   }
   template <typename T>
+  void AllGatherV(
+    const T* mine, T* all, vtkIdType n, vtkIdType* lengths, vtkIdType* offsets, const char* what)
+  {
+    ++this->Collectives;
+    this->Check(this->C->AllGatherV(mine, all, n, lengths, offsets), what);
+  }
+  template <typename T>
   void GatherV(const T* mine, T* all, vtkIdType n, vtkIdType* lengths, vtkIdType* offsets, int root,
     const char* what)
   {
@@ -156,7 +163,10 @@ public:
     this->Check(this->C->ScatterV(all, mine, lengths, offsets, n, root), what);
   }
 
-  vtkMultiProcessController* C;
+  /// The controller, to hand to a VTK filter that runs on the same ranks (never to call
+  /// directly: every collective goes through the counted, checked calls above).
+  vtkMultiProcessController* Controller() const { return this->C; }
+
   const int Rank;
   const int Size;
 
@@ -169,6 +179,7 @@ public:
   static constexpr vtkIdType MaxChunk = vtkIdType(1) << 20;
 
 private:
+  vtkMultiProcessController* C;
   std::string Failure;                    // the first failed communication since the last agreement
   std::unique_ptr<std::uint64_t[]> Drain; // MaxChunk values, for messages without memory
 

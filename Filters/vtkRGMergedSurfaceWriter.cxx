@@ -829,7 +829,7 @@ void vtkRGMergedSurfaceWriter::WriteData()
     // ParaView's parallel form: each rank's piece as it is, and the index on rank 0.
     vtkNew<vtkXMLPPolyDataWriter> pieces;
     ErrorCatcher catcher(pieces);
-    pieces->SetController(ranks.C);
+    pieces->SetController(ranks.Controller());
     pieces->SetNumberOfPieces(ranks.Size);
     pieces->SetStartPiece(ranks.Rank);
     pieces->SetEndPiece(ranks.Rank);
@@ -871,7 +871,7 @@ void vtkRGMergedSurfaceWriter::WriteData()
       static_cast<Int>(mesh.Triangles.size() / 3),
       surface->GetNumberOfPoints() > 0 && !mesh.Normals ? 1 : 0 };
     std::vector<Int> all(3 * static_cast<std::size_t>(ranks.Size));
-    ranks.Check(ranks.C->AllGather(local, all.data(), 3), "exchanging the counts");
+    ranks.AllGather(local, all.data(), 3, "exchanging the counts");
     if (!ranks.Agree(true, problem))
     {
       fail(problem);
@@ -901,7 +901,7 @@ void vtkRGMergedSurfaceWriter::WriteData()
     }
     vtkNew<vtkRGSeamRepair> numbering;
     ErrorCatcher catcher(numbering);
-    numbering->SetController(ranks.C);
+    numbering->SetController(ranks.Controller());
     numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
     numbering->SetInputData(surface);
     numbering->Update(); // collective; it agrees its errors over the ranks itself

@@ -7,6 +7,7 @@
 #include "rgmcSmoothing.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
+#include "vtkRGMessage.h"
 #include "vtkRGThreads.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -61,40 +62,28 @@ constexpr vtkIdType RowGrain = 512;
 template <int Words>
 using Identity = std::array<std::uint64_t, Words>;
 
+/// A coordinate as identity bits: -0 and +0 are one coordinate.
 std::uint64_t Bits(double v)
 {
-  v = v == 0.0 ? 0.0 : v; // -0 and +0 are one coordinate
+  v = v == 0.0 ? 0.0 : v;
   std::uint64_t b;
   std::memcpy(&b, &v, sizeof b);
   return b;
 }
 
-vtkIdType Word(std::uint64_t w)
+/// An identity's word in a message, and back.
+vtkIdType WordOfBits(std::uint64_t bits)
 {
-  vtkIdType v;
-  std::memcpy(&v, &w, sizeof v);
-  return v;
+  vtkIdType word;
+  std::memcpy(&word, &bits, sizeof word);
+  return word;
 }
 
-std::uint64_t Unword(vtkIdType v)
+std::uint64_t BitsOfWord(vtkIdType word)
 {
-  std::uint64_t w;
-  std::memcpy(&w, &v, sizeof w);
-  return w;
-}
-
-vtkIdType PackDouble(double v)
-{
-  vtkIdType b;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
-
-double UnpackDouble(vtkIdType b)
-{
-  double v;
-  std::memcpy(&v, &b, sizeof v);
-  return v;
+  std::uint64_t bits;
+  std::memcpy(&bits, &word, sizeof bits);
+  return bits;
 }
 
 /// This rank's distinct vertices. When every input point is a distinct vertex (the usual case:
@@ -126,7 +115,7 @@ LocalVertices MergeLocal(
     Identity<Words>& id = all[p].first;
     if (Words == 1)
     {
-      id[0] = Unword(keys[p]);
+      id[0] = BitsOfWord(keys[p]);
     }
     else
     {
@@ -176,7 +165,7 @@ LocalVertices MergeLocal(
 
 /// The global id and owner of each of this rank's vertices, and the other holders of the shared
 /// ones.
-struct Numbering
+struct GlobalNumbering
 {
   std::vector<vtkIdType> Gid; // by vertex
   enum : unsigned char
@@ -198,196 +187,246 @@ struct Numbering
 /// sorted identities to the ranks responsible for their ranges (from sampled identities); those
 /// merge the sorted streams, number the distinct identities in order and answer each sender
 /// with the global id of each identity it sent (in its order), and, for identities held by
-/// several ranks, the holders (the lowest owns the vertex). Collective; false (on every rank,
-/// with `problem`) on failure.
+/// several ranks, the holders (the lowest owns the vertex).
 template <int Words>
-bool Number(Ranks& ranks, const LocalVertices& local, std::vector<Identity<Words>>& ids,
-  Numbering& numbering, std::string& problem)
+class IdentityNumbering
 {
-  const int P = ranks.Size;
-  const std::size_t n = ids.size();
-  // Ranges of about equal size, from up to 64 sampled identities per rank.
-  std::vector<vtkIdType> samples;
-  for (std::size_t i = 0, k = std::min<std::size_t>(n, 64); i < k; ++i)
+public:
+  IdentityNumbering(Ranks& ranks, const LocalVertices& vertices, std::vector<Identity<Words>>& ids)
+    : AllRanks(ranks)
+    , Vertices(vertices)
+    , Ids(ids)
+    , SliceStart(ranks.Size + 1, ids.size())
   {
-    for (std::uint64_t w : ids[i * n / k])
-    {
-      samples.push_back(Word(w));
-    }
   }
-  vtkIdType count = static_cast<vtkIdType>(samples.size());
-  std::vector<vtkIdType> counts(P), offsets(P + 1, 0);
-  ranks.Check(ranks.C->AllGather(&count, counts.data(), 1), "gathering sample counts");
-  for (int r = 0; r < P; ++r)
-  {
-    offsets[r + 1] = offsets[r] + counts[r];
-  }
-  std::vector<vtkIdType> allSamples(static_cast<std::size_t>(offsets[P]) + 1);
-  ranks.Check(
-    ranks.C->AllGatherV(samples.data(), allSamples.data(), count, counts.data(), offsets.data()),
-    "gathering samples");
-  std::vector<Identity<Words>> splitters;
-  std::vector<std::size_t> sliceStart(P + 1, n);
-  std::vector<std::vector<vtkIdType>> outgoing(P);
-  if (!ranks.Step("send the vertex identities", problem,
-        [&]()
-        {
-          std::vector<Identity<Words>> sorted(static_cast<std::size_t>(offsets[P] / Words));
-          for (std::size_t s = 0; s < sorted.size(); ++s)
-          {
-            for (int k = 0; k < Words; ++k)
-            {
-              sorted[s][k] = Unword(allSamples[Words * s + k]);
-            }
-          }
-          std::sort(sorted.begin(), sorted.end());
-          for (int h = 1; h < P && !sorted.empty(); ++h)
-          {
-            splitters.push_back(sorted[h * sorted.size() / P]);
-          }
-          // The ranges follow the sorted identities: rank h gets one slice of them.
-          sliceStart[0] = 0;
-          for (int h = 1; h <= P; ++h)
-          {
-            sliceStart[h] = h - 1 < static_cast<int>(splitters.size())
-              ? static_cast<std::size_t>(
-                  std::upper_bound(ids.begin(), ids.end(), splitters[h - 1]) - ids.begin())
-              : n;
-          }
-          for (int h = 0; h < P; ++h)
-          {
-            outgoing[h].reserve(Words * (sliceStart[h + 1] - sliceStart[h]));
-            for (std::size_t i = sliceStart[h]; i < sliceStart[h + 1]; ++i)
-            {
-              for (std::uint64_t w : ids[i])
-              {
-                outgoing[h].push_back(Word(w));
-              }
-            }
-          }
-          std::vector<Identity<Words>>().swap(ids); // no longer needed
-        }))
-  {
-    return false;
-  }
-  const std::vector<bool> everyone(P, true);
-  auto incoming = ranks.Exchange(outgoing, everyone, NumberingTag);
-  std::vector<std::vector<vtkIdType>>().swap(outgoing);
 
-  // Merge the ranks' sorted streams; number the distinct identities in order. Each answer holds
-  // the group number of every identity received (made a global id below), then, for the
-  // identities held by several ranks, (position, number of holders, holders...).
-  std::vector<std::vector<vtkIdType>> answers(P);
-  vtkIdType groups = 0;
-  if (!ranks.Step("number the vertex identities", problem,
-        [&]()
-        {
-          using Head = std::pair<Identity<Words>, int>; // identity, source
-          std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
-          std::vector<std::size_t> next(P, 0);
-          auto push = [&](int s)
-          {
-            const std::vector<vtkIdType>& in = incoming[s];
-            if (next[s] + Words <= in.size())
-            {
-              Identity<Words> id;
-              for (int k = 0; k < Words; ++k)
-              {
-                id[k] = Unword(in[next[s] + k]);
-              }
-              heads.emplace(id, s);
-            }
-          };
-          for (int s = 0; s < P; ++s)
-          {
-            answers[s].reserve(incoming[s].size() / Words);
-            push(s);
-          }
-          std::vector<std::vector<vtkIdType>> sharedRecords(P);
-          std::vector<int> holders; // sources of the current group, in increasing order
-          while (!heads.empty())
-          {
-            const Identity<Words> id = heads.top().first;
-            holders.clear();
-            while (!heads.empty() && heads.top().first == id)
-            {
-              const int s = heads.top().second;
-              heads.pop();
-              holders.push_back(s);
-              answers[s].push_back(groups);
-              next[s] += Words;
-              push(s);
-            }
-            if (holders.size() > 1)
-            {
-              for (int s : holders)
-              {
-                std::vector<vtkIdType>& out = sharedRecords[s];
-                out.insert(out.end(),
-                  { static_cast<vtkIdType>(next[s] / Words - 1),
-                    static_cast<vtkIdType>(holders.size()) });
-                out.insert(out.end(), holders.begin(), holders.end());
-              }
-            }
-            ++groups;
-          }
-          std::vector<std::vector<vtkIdType>>().swap(incoming);
-          for (int s = 0; s < P; ++s)
-          {
-            answers[s].insert(answers[s].end(), sharedRecords[s].begin(), sharedRecords[s].end());
-          }
-        }))
+  /// Collective: AllGather and AllGatherV (the samples), an agreement, an exchange with every
+  /// rank (the identities), an agreement, an AllGather (the count each range numbered), an
+  /// exchange (the answers), an agreement. False (on every rank, with `problem`) on failure.
+  bool Number(GlobalNumbering& numbering, std::string& problem)
   {
-    return false;
-  }
-  std::vector<vtkIdType> groupCounts(P), first(P + 1, 0);
-  ranks.Check(ranks.C->AllGather(&groups, groupCounts.data(), 1), "gathering vertex counts");
-  for (int r = 0; r < P; ++r)
-  {
-    first[r + 1] = first[r] + groupCounts[r];
-  }
-  // The group numbers become global ids at the senders (an answer starts with one number per
-  // identity the sender sent here).
-  auto replies = ranks.Exchange(answers, everyone, AnswerTag);
-  std::vector<std::vector<vtkIdType>>().swap(answers);
-  return ranks.Step("number the vertices", problem,
-    [&]()
+    const std::vector<bool> everyone(this->AllRanks.Size, true);
+    this->GatherSamples();
+    std::vector<std::vector<vtkIdType>> toRanges(this->AllRanks.Size);
+    if (!this->AllRanks.Step(
+          "send the vertex identities", problem, [&]() { this->SliceByRange(toRanges); }))
     {
-      numbering.Total = first[P];
-      numbering.Gid.resize(static_cast<std::size_t>(local.Count));
-      numbering.Holding.assign(static_cast<std::size_t>(local.Count), Numbering::Alone);
-      for (int h = 0; h < P; ++h)
+      return false;
+    }
+    auto received = this->AllRanks.Exchange(toRanges, everyone, NumberingTag);
+    std::vector<std::vector<vtkIdType>>().swap(toRanges);
+    std::vector<std::vector<vtkIdType>> answers(this->AllRanks.Size);
+    if (!this->AllRanks.Step(
+          "number the vertex identities", problem, [&]() { this->NumberRange(received, answers); }))
+    {
+      return false;
+    }
+    this->GatherRangeCounts();
+    const auto replies = this->AllRanks.Exchange(answers, everyone, AnswerTag);
+    std::vector<std::vector<vtkIdType>>().swap(answers);
+    return this->AllRanks.Step(
+      "number the vertices", problem, [&]() { this->StoreAnswers(replies, numbering); });
+  }
+
+private:
+  /// Up to 64 identities sampled on each rank, given to every rank.
+  void GatherSamples()
+  {
+    const int numRanks = this->AllRanks.Size;
+    const std::size_t n = this->Ids.size();
+    std::vector<vtkIdType> samples;
+    for (std::size_t i = 0, k = std::min<std::size_t>(n, 64); i < k; ++i)
+    {
+      for (std::uint64_t w : this->Ids[i * n / k])
       {
-        const std::vector<vtkIdType>& in = replies[h];
-        const std::size_t sent = sliceStart[h + 1] - sliceStart[h];
-        for (std::size_t i = 0; i < sent; ++i)
+        samples.push_back(WordOfBits(w));
+      }
+    }
+    vtkIdType count = static_cast<vtkIdType>(samples.size());
+    std::vector<vtkIdType> counts(numRanks);
+    this->SampleOffsets.assign(numRanks + 1, 0);
+    this->AllRanks.AllGather(&count, counts.data(), 1, "gathering sample counts");
+    for (int r = 0; r < numRanks; ++r)
+    {
+      this->SampleOffsets[r + 1] = this->SampleOffsets[r] + counts[r];
+    }
+    this->AllSamples.resize(static_cast<std::size_t>(this->SampleOffsets[numRanks]) + 1);
+    this->AllRanks.AllGatherV(samples.data(), this->AllSamples.data(), count, counts.data(),
+      this->SampleOffsets.data(), "gathering samples");
+  }
+
+  /// Ranges of about equal size, from the sorted samples; rank h gets one slice of this rank's
+  /// sorted identities. The identities are no longer needed here after that.
+  void SliceByRange(std::vector<std::vector<vtkIdType>>& toRanges)
+  {
+    const int numRanks = this->AllRanks.Size;
+    const std::size_t n = this->Ids.size();
+    std::vector<Identity<Words>> sorted(
+      static_cast<std::size_t>(this->SampleOffsets[numRanks] / Words));
+    for (std::size_t s = 0; s < sorted.size(); ++s)
+    {
+      for (int k = 0; k < Words; ++k)
+      {
+        sorted[s][k] = BitsOfWord(this->AllSamples[Words * s + k]);
+      }
+    }
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<Identity<Words>> splitters;
+    for (int h = 1; h < numRanks && !sorted.empty(); ++h)
+    {
+      splitters.push_back(sorted[h * sorted.size() / numRanks]);
+    }
+    this->SliceStart[0] = 0;
+    for (int h = 1; h <= numRanks; ++h)
+    {
+      this->SliceStart[h] = h - 1 < static_cast<int>(splitters.size())
+        ? static_cast<std::size_t>(
+            std::upper_bound(this->Ids.begin(), this->Ids.end(), splitters[h - 1]) -
+            this->Ids.begin())
+        : n;
+    }
+    for (int h = 0; h < numRanks; ++h)
+    {
+      toRanges[h].reserve(Words * (this->SliceStart[h + 1] - this->SliceStart[h]));
+      for (std::size_t i = this->SliceStart[h]; i < this->SliceStart[h + 1]; ++i)
+      {
+        for (std::uint64_t w : this->Ids[i])
         {
-          numbering.Gid[local.Sorted[sliceStart[h] + i]] = first[h] + in[i];
-        }
-        // Shared identities, in increasing position: the shared vertices come in gid order.
-        for (std::size_t i = sent; i + 1 < in.size();)
-        {
-          const vtkIdType v = local.Sorted[sliceStart[h] + static_cast<std::size_t>(in[i])];
-          const vtkIdType holders = in[i + 1];
-          const int owner = static_cast<int>(in[i + 2]);
-          numbering.SharedVertex.push_back(v);
-          numbering.SharedOwner.push_back(owner);
-          numbering.Holding[v] =
-            owner != ranks.Rank ? Numbering::Shared | Numbering::Foreign : Numbering::Shared;
-          for (vtkIdType j = 0; j < holders; ++j)
-          {
-            const int holder = static_cast<int>(in[i + 2 + j]);
-            if (holder != ranks.Rank)
-            {
-              numbering.Sharers.push_back(holder);
-            }
-          }
-          numbering.SharerOffsets.push_back(static_cast<vtkIdType>(numbering.Sharers.size()));
-          i += 2 + static_cast<std::size_t>(holders);
+          toRanges[h].push_back(WordOfBits(w));
         }
       }
-    });
-}
+    }
+    std::vector<Identity<Words>>().swap(this->Ids);
+  }
+
+  /// Merges the ranks' sorted streams of this range and numbers the distinct identities in
+  /// order. Each answer holds the range's number of every identity received (made a global id
+  /// by the sender), then, for the identities held by several ranks, (position, number of
+  /// holders, holders...).
+  void NumberRange(
+    std::vector<std::vector<vtkIdType>>& received, std::vector<std::vector<vtkIdType>>& answers)
+  {
+    const int numRanks = this->AllRanks.Size;
+    using Head = std::pair<Identity<Words>, int>; // identity, source
+    std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
+    std::vector<std::size_t> next(numRanks, 0);
+    auto push = [&](int s)
+    {
+      const std::vector<vtkIdType>& in = received[s];
+      if (next[s] + Words <= in.size())
+      {
+        Identity<Words> id;
+        for (int k = 0; k < Words; ++k)
+        {
+          id[k] = BitsOfWord(in[next[s] + k]);
+        }
+        heads.emplace(id, s);
+      }
+    };
+    for (int s = 0; s < numRanks; ++s)
+    {
+      answers[s].reserve(received[s].size() / Words);
+      push(s);
+    }
+    std::vector<std::vector<vtkIdType>> sharedRecords(numRanks);
+    std::vector<int> holders; // sources of the current identity, in increasing order
+    while (!heads.empty())
+    {
+      const Identity<Words> id = heads.top().first;
+      holders.clear();
+      while (!heads.empty() && heads.top().first == id)
+      {
+        const int s = heads.top().second;
+        heads.pop();
+        holders.push_back(s);
+        answers[s].push_back(this->Numbered);
+        next[s] += Words;
+        push(s);
+      }
+      if (holders.size() > 1)
+      {
+        for (int s : holders)
+        {
+          std::vector<vtkIdType>& out = sharedRecords[s];
+          out.insert(out.end(),
+            { static_cast<vtkIdType>(next[s] / Words - 1),
+              static_cast<vtkIdType>(holders.size()) });
+          out.insert(out.end(), holders.begin(), holders.end());
+        }
+      }
+      ++this->Numbered;
+    }
+    std::vector<std::vector<vtkIdType>>().swap(received);
+    for (int s = 0; s < numRanks; ++s)
+    {
+      answers[s].insert(answers[s].end(), sharedRecords[s].begin(), sharedRecords[s].end());
+    }
+  }
+
+  /// The first global id of each range: the counts of the ranges before it.
+  void GatherRangeCounts()
+  {
+    const int numRanks = this->AllRanks.Size;
+    std::vector<vtkIdType> counts(numRanks);
+    this->RangeFirst.assign(numRanks + 1, 0);
+    this->AllRanks.AllGather(&this->Numbered, counts.data(), 1, "gathering vertex counts");
+    for (int r = 0; r < numRanks; ++r)
+    {
+      this->RangeFirst[r + 1] = this->RangeFirst[r] + counts[r];
+    }
+  }
+
+  /// The global id of each vertex, and the holders of the shared ones (in increasing position
+  /// in each answer: the shared vertices come in global-id order).
+  void StoreAnswers(
+    const std::vector<std::vector<vtkIdType>>& replies, GlobalNumbering& numbering) const
+  {
+    const int numRanks = this->AllRanks.Size, me = this->AllRanks.Rank;
+    numbering.Total = this->RangeFirst[numRanks];
+    numbering.Gid.resize(static_cast<std::size_t>(this->Vertices.Count));
+    numbering.Holding.assign(
+      static_cast<std::size_t>(this->Vertices.Count), GlobalNumbering::Alone);
+    for (int h = 0; h < numRanks; ++h)
+    {
+      const std::vector<vtkIdType>& in = replies[h];
+      const std::size_t sent = this->SliceStart[h + 1] - this->SliceStart[h];
+      for (std::size_t i = 0; i < sent; ++i)
+      {
+        numbering.Gid[this->Vertices.Sorted[this->SliceStart[h] + i]] = this->RangeFirst[h] + in[i];
+      }
+      for (std::size_t i = sent; i + 1 < in.size();)
+      {
+        const vtkIdType v =
+          this->Vertices.Sorted[this->SliceStart[h] + static_cast<std::size_t>(in[i])];
+        const vtkIdType holders = in[i + 1];
+        const int owner = static_cast<int>(in[i + 2]);
+        numbering.SharedVertex.push_back(v);
+        numbering.SharedOwner.push_back(owner);
+        numbering.Holding[v] = owner != me ? GlobalNumbering::Shared | GlobalNumbering::Foreign
+                                           : GlobalNumbering::Shared;
+        for (vtkIdType j = 0; j < holders; ++j)
+        {
+          const int holder = static_cast<int>(in[i + 2 + j]);
+          if (holder != me)
+          {
+            numbering.Sharers.push_back(holder);
+          }
+        }
+        numbering.SharerOffsets.push_back(static_cast<vtkIdType>(numbering.Sharers.size()));
+        i += 2 + static_cast<std::size_t>(holders);
+      }
+    }
+  }
+
+  Ranks& AllRanks;
+  const LocalVertices& Vertices;
+  std::vector<Identity<Words>>& Ids;    // this rank's, sorted (released once sent)
+  std::vector<vtkIdType> SampleOffsets; // per rank, into AllSamples (in words)
+  std::vector<vtkIdType> AllSamples;
+  std::vector<std::size_t> SliceStart; // per range: its first identity of this rank's
+  vtkIdType Numbered = 0;              // distinct identities in this rank's range
+  std::vector<vtkIdType> RangeFirst;   // per range: its first global id
+};
 
 // ---- the mesh around each owned vertex ---------------------------------------------------------
 
@@ -442,25 +481,91 @@ struct Checks
   vtkIdType Edges = 0, Boundary = 0, Border = 0, NonManifold = 0;
 };
 
-/// The repair of one rank's piece, with points of type T and triangles over vertex indices of
-/// type I (the input's own connectivity when its points need no merging).
+// ---- the input and the output --------------------------------------------------------------
+
+/// The positions and triangles of this rank's vertices: the input's own arrays when no points
+/// are merged and they have the types asked for, otherwise copies (`copied`, `connectivity`).
+/// Every cell is a triangle (checked before).
 template <typename T, typename I>
-class Repair
+const I* CopyInput(vtkPolyData* input, const LocalVertices& vertices, const T*& positions,
+  std::vector<T>& copied, std::vector<vtkIdType>& connectivity)
+{
+  using PointArray = vtkAOSDataArrayTemplate<T>;
+  PointArray* inputPoints =
+    input->GetPoints() ? PointArray::FastDownCast(input->GetPoints()->GetData()) : nullptr;
+  if (inputPoints && !vertices.Merged())
+  {
+    positions = inputPoints->GetPointer(0);
+  }
+  else
+  {
+    copied.resize(static_cast<std::size_t>(3 * vertices.Count));
+    for (vtkIdType v = 0; v < vertices.Count; ++v)
+    {
+      double p[3];
+      input->GetPoint(vertices.PointOf(v), p);
+      for (int k = 0; k < 3; ++k)
+      {
+        copied[3 * v + k] = static_cast<T>(p[k]);
+      }
+    }
+    positions = copied.data();
+  }
+  using IndexArray = vtkAOSDataArrayTemplate<I>;
+  IndexArray* typed = IndexArray::FastDownCast(input->GetPolys()->GetConnectivityArray());
+  if (typed && !vertices.Merged())
+  {
+    return typed->GetPointer(0);
+  }
+  if constexpr (std::is_same<I, vtkIdType>::value)
+  {
+    connectivity.reserve(static_cast<std::size_t>(3 * input->GetNumberOfPolys()));
+    vtkCellArray* polys = input->GetPolys();
+    vtkIdType npts;
+    const vtkIdType* pts;
+    for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        connectivity.push_back(vertices.VertexOf(pts[k]));
+      }
+    }
+    return connectivity.data();
+  }
+  return nullptr;
+}
+
+/// What the smoothing is asked to do.
+struct SmoothingSettings
+{
+  int Method = vtkRGSeamRepair::NO_SMOOTHING;
+  int Iterations = 0;
+  double Relaxation = 0.0;
+  double PassBand = 0.0;
+  rgmc::SincWindow Window = rgmc::SincWindow::Nuttall;
+};
+
+/// The repair of one rank's piece, with points of type T and triangles over vertex indices of
+/// type I (the input's own connectivity when its points need no merging): the seams analysed,
+/// the smoothing, the normals. Each public step is collective and returns false (on every rank,
+/// with `problem`) on failure.
+template <typename T, typename I>
+class PieceRepair
 {
 public:
-  Repair(Ranks& ranks, const LocalVertices& local, const Numbering& numbering,
-    const BorderTest& border, const vtkIdType* keys, const T* x, const I* triangles,
+  PieceRepair(Ranks& ranks, const LocalVertices& vertices, const GlobalNumbering& numbering,
+    const BorderTest& border, const vtkIdType* keys, const T* positions, const I* triangles,
     vtkIdType numTriangles)
-    : R(ranks)
-    , Local(local)
-    , Num(numbering)
+    : AllRanks(ranks)
+    , Vertices(vertices)
+    , Numbering(numbering)
     , Border(border)
     , Grid(border.Whole, border.Whole)
     , Keys(keys)
-    , X(x)
+    , Positions(positions)
     , Triangles(triangles)
     , NumTriangles(numTriangles)
-    , N(local.Count)
+    , NumVertices(vertices.Count)
     , ToSharer(ranks.Size)
     , FromOwner(ranks.Size)
     , Provide(ranks.Size)
@@ -474,678 +579,97 @@ public:
     }
   }
 
-  /// The edges at each vertex (with repeats: once per triangle side), gathered at owners;
-  /// smoothing stencils of owned vertices; global checks. Collective; false (on every rank, with
-  /// `problem`) on failure.
-  bool Analyze(bool stencils, Checks& checks, std::string& problem)
+  /// The edges at each vertex (with repeats: once per triangle side), gathered at owners; the
+  /// global checks' counts of this rank; smoothing stencils of owned vertices (when `stencils`)
+  /// and the plan of the smoothing's exchanges. Two exchanges with the ranks that share
+  /// vertices, three agreements.
+  bool AnalyzeSeams(bool stencils, Checks& checks, std::string& problem)
   {
-    const int P = this->R.Size, me = this->R.Rank;
-    const std::vector<vtkIdType>& gid = this->Num.Gid;
-    std::vector<Neighbour> all;
-    std::vector<std::pair<vtkIdType, vtkIdType>> ends; // (gid, vertex) of edge ends
-    // The corners of the triangles at each vertex, in compressed rows.
-    std::vector<vtkIdType> cornerOffsets, corners;
-    // The ends of this rank's edges at vertex v (once per triangle side), sorted by gid, into
-    // `out` (reads only: threads may call it at once).
-    auto endsAt = [&](vtkIdType v, std::vector<std::pair<vtkIdType, vtkIdType>>& out)
-    {
-      out.clear();
-      for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
-      {
-        const vtkIdType t = corners[c] / 3, k = corners[c] % 3;
-        for (vtkIdType other : { (k + 1) % 3, (k + 2) % 3 })
-        {
-          const vtkIdType w = static_cast<vtkIdType>(this->Triangles[3 * t + other]);
-          out.emplace_back(gid[w], w);
-        }
-      }
-      std::sort(out.begin(), out.end());
-    };
-    auto localEnds = [&](vtkIdType v) { endsAt(v, ends); };
-    // This rank's edges at vertex v, sorted by the neighbour's gid, into `out`.
-    auto localNeighbours = [&](vtkIdType v, std::vector<Neighbour>& out)
-    {
-      localEnds(v);
-      for (std::size_t e = 0; e < ends.size();)
-      {
-        std::size_t end = e;
-        while (end < ends.size() && ends[end].first == ends[e].first)
-        {
-          ++end;
-        }
-        out.push_back(Neighbour{
-          ends[e].first, static_cast<int>(end - e), ends[e].second, me, 0, { 0, 0, 0 } });
-        e = end;
-      }
-    };
-
-    // Edges at shared vertices go to their owners (shared vertices in gid order: each owner
-    // receives them in its own order).
-    std::vector<std::vector<vtkIdType>> outgoing(P);
-    if (!this->R.Step("list the edges at the seams", problem,
+    std::vector<std::vector<vtkIdType>> toOwners(this->AllRanks.Size);
+    if (!this->AllRanks.Step("list the edges at the seams", problem,
           [&]()
           {
-            this->CornersAround(cornerOffsets, corners);
-            for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
-            {
-              const int owner = this->Num.SharedOwner[i];
-              if (owner == me)
-              {
-                continue;
-              }
-              const vtkIdType v = this->Num.SharedVertex[i];
-              all.clear();
-              localNeighbours(v, all);
-              std::vector<vtkIdType>& out = outgoing[owner];
-              out.push_back(gid[v]);
-              out.push_back(static_cast<vtkIdType>(all.size()));
-              for (const Neighbour& nb : all)
-              {
-                const T* x = this->X + 3 * nb.Local;
-                out.insert(out.end(),
-                  { nb.Gid, nb.Uses, this->MaskOf(nb.Local), PackDouble(static_cast<double>(x[0])),
-                    PackDouble(static_cast<double>(x[1])), PackDouble(static_cast<double>(x[2])) });
-              }
-            }
+            this->CornersAround(this->CornerOffsets, this->Corners);
+            this->ListSeamEdges(toOwners);
           }))
     {
       return false;
     }
-    const auto incoming = this->R.Exchange(outgoing, this->Partners, EdgesTag);
-    std::vector<std::vector<vtkIdType>>().swap(outgoing);
-
-    // Every owned vertex, in gid order: its whole neighbourhood, the checks, its stencil.
-    struct Pending // a neighbour held elsewhere, until remote slots are numbered
-    {
-      vtkIdType Gid;
-      int Provider;
-      double X[3];
-    };
-    std::vector<Pending> pending;
-    if (!this->R.Step("make the smoothing stencils", problem,
+    const auto received = this->AllRanks.Exchange(toOwners, this->Partners, EdgesTag);
+    std::vector<std::vector<vtkIdType>>().swap(toOwners);
+    if (!this->AllRanks.Step("make the smoothing stencils", problem,
           [&]()
           {
-            std::vector<std::size_t> cursor(P, 0);
-            std::vector<rgmc::IncidentEdge> incident;
-            std::vector<std::int64_t> stencil;
-            const double cosEdgeAngle = std::cos(vtkMath::RadiansFromDegrees(15.0));
-            if (stencils)
-            {
-              this->Owned.reserve(static_cast<std::size_t>(this->N));
-              this->Stencil.Offsets.reserve(static_cast<std::size_t>(this->N) + 1);
-              this->Stencil.Neighbours.reserve(static_cast<std::size_t>(3 * this->NumTriangles));
-            }
-            // Any vertex: its whole neighbourhood (with the edges other ranks sent, for a shared
-            // one), the checks, its stencil.
-            auto general = [&](vtkIdType v, bool isShared, std::size_t sharedIndex)
-            {
-              all.clear();
-              localNeighbours(v, all);
-              if (isShared)
-              {
-                for (vtkIdType h = this->Num.SharerOffsets[sharedIndex];
-                     h < this->Num.SharerOffsets[sharedIndex + 1]; ++h)
-                {
-                  const int s = this->Num.Sharers[h];
-                  const std::vector<vtkIdType>& in = incoming[s];
-                  std::size_t& i = cursor[s];
-                  if (i + 1 >= in.size() || in[i] != gid[v])
-                  {
-                    continue;
-                  }
-                  const vtkIdType count = in[i + 1];
-                  i += 2;
-                  for (vtkIdType j = 0; j < count; ++j, i += 6)
-                  {
-                    all.push_back(Neighbour{ in[i], static_cast<int>(in[i + 1]), -1, s,
-                      static_cast<int>(in[i + 2]),
-                      { UnpackDouble(in[i + 3]), UnpackDouble(in[i + 4]),
-                        UnpackDouble(in[i + 5]) } });
-                  }
-                }
-                std::stable_sort(all.begin(), all.end(),
-                  [](const Neighbour& a, const Neighbour& b) { return a.Gid < b.Gid; });
-                // Merge the ranks' counts of each edge; keep the local copy of the neighbour.
-                std::size_t kept = 0;
-                for (std::size_t i = 0; i < all.size(); ++i)
-                {
-                  if (kept > 0 && all[kept - 1].Gid == all[i].Gid)
-                  {
-                    all[kept - 1].Uses += all[i].Uses;
-                    if (all[kept - 1].Local < 0 && all[i].Local >= 0)
-                    {
-                      all[kept - 1] = Neighbour{ all[i].Gid, all[kept - 1].Uses, all[i].Local, me,
-                        0, { 0, 0, 0 } };
-                    }
-                  }
-                  else
-                  {
-                    all[kept++] = all[i];
-                  }
-                }
-                all.resize(kept);
-              }
-              const int myMask = this->MaskOf(v);
-              incident.clear();
-              for (const Neighbour& nb : all)
-              {
-                incident.push_back(rgmc::IncidentEdge{ nb.Gid, nb.Uses });
-                if (nb.Gid > gid[v])
-                {
-                  ++checks.Edges;
-                  if (nb.Uses == 1)
-                  {
-                    const int mask = nb.Local >= 0 ? this->MaskOf(nb.Local) : nb.Mask;
-                    ++((myMask & mask) ? checks.Border : checks.Boundary);
-                  }
-                  else if (nb.Uses > 2)
-                  {
-                    ++checks.NonManifold;
-                  }
-                }
-              }
-              if (!stencils)
-              {
-                return;
-              }
-              auto find = [&all](vtkIdType g) -> const Neighbour&
-              {
-                return *std::lower_bound(all.begin(), all.end(), g,
-                  [](const Neighbour& nb, vtkIdType key) { return nb.Gid < key; });
-              };
-              auto position = [&](const Neighbour& nb, T x[3])
-              {
-                for (int k = 0; k < 3; ++k)
-                {
-                  x[k] = nb.Local >= 0 ? this->X[3 * nb.Local + k] : static_cast<T>(nb.X[k]);
-                }
-              };
-              rgmc::SmoothingStencil(
-                incident,
-                [&](std::int64_t a, std::int64_t b)
-                {
-                  T pa[3], pb[3];
-                  position(find(a), pa);
-                  position(find(b), pb);
-                  return rgmc::ExceedsEdgeAngle(pa, this->X + 3 * v, pb, cosEdgeAngle);
-                },
-                stencil);
-              this->Owned.push_back(v);
-              for (std::int64_t g : stencil)
-              {
-                const Neighbour& nb = find(g);
-                if (nb.Local >= 0)
-                {
-                  this->Stencil.Neighbours.push_back(nb.Local);
-                  continue;
-                }
-                this->Stencil.Neighbours.push_back(-1 - static_cast<std::int64_t>(pending.size()));
-                pending.push_back(Pending{ nb.Gid, nb.Provider, { nb.X[0], nb.X[1], nb.X[2] } });
-              }
-              this->Stencil.Offsets.push_back(
-                static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
-            };
-            // Vertices no other rank holds, in memory order: most are inside a closed manifold
-            // piece of the surface, where every edge has two triangles and the stencil is simply
-            // the neighbours in gid order. Those are found on threads, in blocks of vertices
-            // (each block's rows kept apart), then taken block by block in order, the others
-            // going through the general path there: the same rows, in the same order, for any
-            // number of threads.
-            // Whether vertex v (no other rank holds it) is inside a manifold piece; if so, its
-            // edges are counted in `edges` and its row appended to `row` (when stencils are
-            // made). Reads only: threads may call it at once.
-            auto manifoldRow = [&](vtkIdType v, std::vector<std::pair<vtkIdType, vtkIdType>>& at,
-                                 std::vector<std::int64_t>& row, vtkIdType& edges)
-            {
-              endsAt(v, at);
-              bool manifold = !at.empty() && at.size() < 2 * 255;
-              for (std::size_t e = 0; e < at.size() && manifold; e += 2)
-              {
-                manifold = e + 1 < at.size() && at[e + 1].first == at[e].first &&
-                  (e + 2 == at.size() || at[e + 2].first != at[e].first);
-              }
-              if (!manifold)
-              {
-                return false;
-              }
-              for (std::size_t e = 0; e < at.size(); e += 2)
-              {
-                edges += at[e].first > gid[v];
-                if (stencils)
-                {
-                  row.push_back(at[e].second);
-                }
-              }
-              return true;
-            };
-            auto ownRow = [&](vtkIdType v)
-            {
-              this->Owned.push_back(v);
-              this->Stencil.Offsets.push_back(
-                static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
-            };
-            if (vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
-            {
-              // One thread: straight into the stencils.
-              for (vtkIdType v = 0; v < this->N; ++v)
-              {
-                if (this->Num.Holding[v] != Numbering::Alone)
-                {
-                  continue;
-                }
-                if (!manifoldRow(v, ends, this->Stencil.Neighbours, checks.Edges))
-                {
-                  general(v, false, 0);
-                }
-                else if (stencils)
-                {
-                  ownRow(v);
-                }
-              }
-            }
-            struct Block
-            {
-              std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex of the general path
-              std::vector<vtkIdType> Ends;     // row ends in Neighbours, per manifold vertex
-              std::vector<std::int64_t> Neighbours;
-              vtkIdType Edges = 0;
-            };
-            // Batches of blocks bound the rows held apart (memory), whatever the mesh's size.
-            const vtkIdType blockSize = 4096, batchBlocks = 64;
-            const vtkIdType numBlocks = vtkSMPTools::GetEstimatedNumberOfThreads() <= 1
-              ? 0
-              : (this->N + blockSize - 1) / blockSize;
-            std::vector<Block> blocks;
-            for (vtkIdType batch = 0; batch < numBlocks; batch += batchBlocks)
-            {
-              blocks.assign(
-                static_cast<std::size_t>(std::min(batchBlocks, numBlocks - batch)), Block());
-              rgmc::ParallelFor(static_cast<vtkIdType>(blocks.size()), 1,
-                [&](vtkIdType first, vtkIdType last)
-                {
-                  std::vector<std::pair<vtkIdType, vtkIdType>> blockEnds;
-                  for (vtkIdType b = first; b < last; ++b)
-                  {
-                    Block& block = blocks[b];
-                    const vtkIdType start = (batch + b) * blockSize;
-                    for (vtkIdType v = start; v < std::min(this->N, start + blockSize); ++v)
-                    {
-                      if (this->Num.Holding[v] != Numbering::Alone)
-                      {
-                        continue;
-                      }
-                      const bool manifold =
-                        manifoldRow(v, blockEnds, block.Neighbours, block.Edges);
-                      block.Vertices.push_back(manifold ? v : -1 - v);
-                      if (manifold)
-                      {
-                        block.Ends.push_back(static_cast<vtkIdType>(block.Neighbours.size()));
-                      }
-                    }
-                  }
-                });
-              for (Block& block : blocks)
-              {
-                checks.Edges += block.Edges;
-                std::size_t row = 0;
-                vtkIdType begin = 0;
-                for (const vtkIdType entry : block.Vertices)
-                {
-                  if (entry < 0)
-                  {
-                    general(-1 - entry, false, 0);
-                    continue;
-                  }
-                  const vtkIdType end = block.Ends[row++];
-                  if (stencils)
-                  {
-                    this->Stencil.Neighbours.insert(this->Stencil.Neighbours.end(),
-                      block.Neighbours.begin() + begin, block.Neighbours.begin() + end);
-                    ownRow(entry);
-                  }
-                  begin = end;
-                }
-                block = Block();
-              }
-            }
-            // Shared vertices this rank owns, in gid order (the order of the received edges).
-            for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
-            {
-              if (this->Num.SharedOwner[i] == me)
-              {
-                general(this->Num.SharedVertex[i], true, i);
-              }
-            }
-            std::vector<vtkIdType>().swap(corners);
-            std::vector<vtkIdType>().swap(cornerOffsets);
-
-            // The neighbours held elsewhere get slots N, N + 1, ... in gid order.
-            std::vector<vtkIdType> order(pending.size()), slotOf(pending.size());
-            std::iota(order.begin(), order.end(), vtkIdType(0));
-            std::sort(order.begin(), order.end(),
-              [&pending](vtkIdType a, vtkIdType b) { return pending[a].Gid < pending[b].Gid; });
-            for (vtkIdType o : order)
-            {
-              const Pending& p = pending[o];
-              if (this->RemoteGids.empty() || this->RemoteGids.back() != p.Gid)
-              {
-                this->RemoteGids.push_back(p.Gid);
-                this->RemoteProviders.push_back(p.Provider);
-                this->RemoteInitial.insert(this->RemoteInitial.end(), p.X, p.X + 3);
-              }
-              slotOf[o] = static_cast<vtkIdType>(this->RemoteGids.size()) - 1;
-            }
-            for (std::int64_t& s : this->Stencil.Neighbours)
-            {
-              s = s < 0 ? this->N + slotOf[-1 - s] : s;
-            }
-            // Who sends what each iteration: the neighbours owners lack, from ranks that hold
-            // them; the owners' new positions, to the other holders (both sides list a pair's
-            // vertices in gid order).
-            for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
-            {
-              this->RequestLists[this->RemoteProviders[r]].push_back(this->RemoteGids[r]);
-              this->RemoteOrder[this->RemoteProviders[r]].push_back(
-                this->N + static_cast<vtkIdType>(r));
-            }
-            for (std::size_t i = 0; i < this->Num.SharedVertex.size(); ++i)
-            {
-              const vtkIdType v = this->Num.SharedVertex[i];
-              if (this->Num.SharedOwner[i] == me)
-              {
-                for (vtkIdType h = this->Num.SharerOffsets[i]; h < this->Num.SharerOffsets[i + 1];
-                     ++h)
-                {
-                  this->ToSharer[this->Num.Sharers[h]].push_back(v);
-                }
-              }
-              else
-              {
-                this->FromOwner[this->Num.SharedOwner[i]].push_back(v);
-              }
-            }
+            this->AssembleNeighbourhoods(received, stencils, checks);
+            this->NumberRemoteNeighbours();
+            this->ListSharedVertices();
           }))
     {
       return false;
     }
-    const auto asked = this->R.Exchange(this->RequestLists, this->Partners, RequestTag);
+    const auto asked = this->AllRanks.Exchange(this->RequestLists, this->Partners, RequestTag);
     std::vector<std::vector<vtkIdType>>().swap(this->RequestLists);
-    return this->R.Step("plan the smoothing's exchanges", problem,
-      [&]()
-      {
-        for (int s = 0; s < P; ++s)
-        {
-          for (vtkIdType g : asked[s])
-          {
-            this->Provide[s].push_back(this->VertexOfGid(g));
-          }
-        }
-      });
+    return this->AllRanks.Step(
+      "plan the smoothing's exchanges", problem, [&]() { this->ListProvided(asked); });
   }
 
-  /// Smooths the positions into Smoothed. Returns false when aborted or failed (with
-  /// `problem`). Collective.
-  bool Smooth(int method, int iterations, double relaxation, double passBand,
-    rgmc::SincWindow window, const std::function<bool(double)>& progress, std::string& problem)
+  /// Smooths the positions into Smoothed. Returns false when aborted (`problem` empty) or
+  /// failed. Per iteration: a reduction (abort) and two exchanges with the sharing ranks.
+  bool Smooth(const SmoothingSettings& settings, const std::function<bool(double)>& progress,
+    std::string& problem)
   {
-    const std::size_t size = 3 * (this->N + this->RemoteGids.size());
-    std::vector<T> a, b, c, sum;       // windowed sinc: in the points' type, as VTK's filter
-    std::vector<double> current, next; // Laplacian: in double, rounded once at the end
-    std::vector<double> coefficients;
-    const bool sinc = method == vtkRGSeamRepair::WINDOWED_SINC;
-    if (!this->R.Step("smooth the surface", problem,
-          [&]()
-          {
-            if (!sinc)
-            {
-              current.resize(size);
-              next.resize(size);
-              std::copy(this->X, this->X + 3 * this->N, current.begin());
-              std::copy(this->RemoteInitial.begin(), this->RemoteInitial.end(),
-                current.begin() + 3 * this->N);
-              return;
-            }
-            a.resize(size);
-            b.resize(size);
-            std::copy(this->X, this->X + 3 * this->N, a.begin());
-            for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
-            {
-              for (int k = 0; k < 3; ++k)
-              {
-                a[3 * (this->N + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
-              }
-            }
-            {
-              c.resize(size);
-              sum.resize(size);
-              coefficients = rgmc::SincCoefficients(iterations, passBand, window);
-            }
-          }))
+    bool aborted = false;
+    const bool done = settings.Method == vtkRGSeamRepair::WINDOWED_SINC
+      ? this->SmoothWindowedSinc(settings, progress, aborted, problem)
+      : this->SmoothLaplacian(settings, progress, aborted, problem);
+    if (!done)
     {
       return false;
-    }
-    bool aborted = false;
-    if (!sinc)
-    {
-      for (int it = 0; it < iterations && !aborted; ++it)
-      {
-        if (progress(double(it) / iterations))
-        {
-          aborted = true;
-          break;
-        }
-        this->Fetch(current.data());
-        rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
-          [&](vtkIdType first, vtkIdType last)
-          {
-            rgmc::LaplacianStep(
-              this->Stencil, this->Owned, current.data(), next.data(), relaxation, first, last);
-          });
-        this->Update(next.data());
-        std::swap(current, next);
-      }
-      std::vector<double>().swap(next);
-      if (!this->R.Step("smooth the surface", problem,
-            [&]() { this->Smoothed.assign(current.begin(), current.begin() + 3 * this->N); }))
-      {
-        return false;
-      }
-    }
-    else
-    {
-      // Windowed sinc: x0 = a, x1 = b, x2 = c, x3 = sum.
-      T* x0 = a.data();
-      T* x1 = b.data();
-      T* x2 = c.data();
-      this->Fetch(x0);
-      rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
-        [&](vtkIdType first, vtkIdType last)
-        {
-          rgmc::SincFirstStep(
-            this->Stencil, this->Owned, x0, x1, sum.data(), coefficients.data(), first, last);
-        });
-      this->Update(x1);
-      for (int it = 2; it <= iterations; ++it)
-      {
-        if (progress(double(it) / iterations))
-        {
-          aborted = true;
-          break;
-        }
-        this->Fetch(x1);
-        rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
-          [&](vtkIdType first, vtkIdType last)
-          {
-            rgmc::SincStep(
-              this->Stencil, this->Owned, x0, x1, x2, sum.data(), coefficients[it], first, last);
-          });
-        this->Update(x2);
-        T* oldest = x0;
-        x0 = x1;
-        x1 = x2;
-        x2 = oldest;
-      }
-      this->Update(sum.data());
-      this->Smoothed.swap(sum);
     }
     // The stencils are done with: the normals need the memory.
     std::vector<std::int64_t>().swap(this->Stencil.Neighbours);
     std::vector<std::int64_t>().swap(this->Stencil.Offsets);
     std::vector<std::int64_t>().swap(this->Owned);
-    if (!this->R.Agree(true, problem) || aborted)
+    if (!this->AllRanks.Agree(true, problem) || aborted)
     {
       return false;
     }
-    this->Smoothed.resize(3 * this->N);
+    this->Smoothed.resize(3 * this->NumVertices);
     return true;
   }
 
   /// Area-weighted vertex normals of the smoothed positions. Each vertex sums its triangles'
   /// area vectors in one order fixed by the mesh (by the triangles' sorted global ids), at its
-  /// owner, so that the normals are the same to the bit for any number of ranks. Collective;
-  /// empty on failure (on every rank, with `problem`).
+  /// owner, so that the normals are the same to the bit for any number of ranks. Two exchanges,
+  /// three agreements; empty on failure.
   std::vector<float> Normals(std::string& problem)
   {
-    const std::vector<vtkIdType>& gid = this->Num.Gid;
-    const T* x = this->Smoothed.data();
-    // A triangle: its sorted global ids, and its area vector taken from its corner of smallest
-    // global id (orientation kept), so that every rank computes the same bits.
-    struct Term
-    {
-      std::array<vtkIdType, 3> Key;
-      double Cross[3];
-      bool operator<(const Term& o) const { return this->Key < o.Key; }
-    };
-    auto term = [&](vtkIdType t)
-    {
-      vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
-        static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
-        static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
-      const int first =
-        gid[c[0]] < gid[c[1]] ? (gid[c[0]] < gid[c[2]] ? 0 : 2) : (gid[c[1]] < gid[c[2]] ? 1 : 2);
-      std::rotate(c, c + first, c + 3);
-      Term out;
-      double e1[3], e2[3];
-      for (int k = 0; k < 3; ++k)
-      {
-        e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
-        e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
-      }
-      vtkMath::Cross(e1, e2, out.Cross);
-      out.Key = { gid[c[0]], gid[c[1]], gid[c[2]] };
-      std::sort(out.Key.begin(), out.Key.end());
-      return out;
-    };
-    std::vector<vtkIdType> cornerOffsets, corners;
-    std::vector<Term> terms;
-    auto localTerms = [&](vtkIdType v)
-    {
-      terms.clear();
-      for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
-      {
-        terms.push_back(term(corners[c] / 3));
-      }
-    };
-    // The normal of a vertex: its terms summed in the order of their keys.
-    auto SumTerms = [](std::vector<Term>& list, double n[3])
-    {
-      std::sort(list.begin(), list.end());
-      n[0] = n[1] = n[2] = 0;
-      for (const Term& t : list)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          n[k] += t.Cross[k];
-        }
-      }
-      vtkMath::Normalize(n);
-    };
-    auto sum = [&](double n[3]) { SumTerms(terms, n); };
-
-    // The terms of shared vertices go to their owners (in gid order, as the owners list them).
-    std::vector<double> n;
-    std::vector<std::vector<vtkIdType>> outgoing(this->R.Size);
-    if (!this->R.Step("compute normals", problem,
+    std::vector<double> sums;
+    std::vector<std::vector<vtkIdType>> toOwners(this->AllRanks.Size);
+    if (!this->AllRanks.Step("compute normals", problem,
           [&]()
           {
-            n.assign(3 * this->N, 0.0);
-            this->CornersAround(cornerOffsets, corners);
-            for (int o = 0; o < this->R.Size; ++o)
-            {
-              for (vtkIdType v : this->FromOwner[o])
-              {
-                localTerms(v);
-                outgoing[o].push_back(static_cast<vtkIdType>(terms.size()));
-                for (const Term& t : terms)
-                {
-                  outgoing[o].insert(outgoing[o].end(),
-                    { t.Key[0], t.Key[1], t.Key[2], PackDouble(t.Cross[0]), PackDouble(t.Cross[1]),
-                      PackDouble(t.Cross[2]) });
-                }
-              }
-            }
+            sums.assign(3 * this->NumVertices, 0.0);
+            this->CornersAround(this->CornerOffsets, this->Corners);
+            this->ListSharedTerms(toOwners);
           }))
     {
       return {};
     }
-    const auto incoming = this->R.Exchange(outgoing, this->Partners, NormalTag);
+    const auto received = this->AllRanks.Exchange(toOwners, this->Partners, NormalTag);
     std::vector<float> normals;
-    if (!this->R.Step("compute normals", problem,
+    if (!this->AllRanks.Step("compute normals", problem,
           [&]()
           {
-            // Each vertex's own terms, on threads (each range with its own list of terms).
-            rgmc::ParallelFor(this->N, RowGrain,
-              [&](vtkIdType first, vtkIdType last)
-              {
-                std::vector<Term> own;
-                for (vtkIdType v = first; v < last; ++v)
-                {
-                  own.clear();
-                  for (vtkIdType c = cornerOffsets[v]; c < cornerOffsets[v + 1]; ++c)
-                  {
-                    own.push_back(term(corners[c] / 3));
-                  }
-                  SumTerms(own, &n[3 * v]);
-                }
-              });
-            // Owned shared vertices: their own terms and every holder's, in the same order.
-            std::vector<std::size_t> cursor(this->R.Size, 0);
-            std::vector<std::pair<vtkIdType, int>> order; // (gid, sharer) of owned shared vertices
-            for (int s = 0; s < this->R.Size; ++s)
-            {
-              if (s != this->R.Rank)
-              {
-                for (vtkIdType v : this->ToSharer[s])
-                {
-                  order.emplace_back(gid[v], s);
-                }
-              }
-            }
-            std::sort(order.begin(), order.end());
-            for (std::size_t i = 0; i < order.size();)
-            {
-              const vtkIdType v = this->VertexOfGid(order[i].first);
-              localTerms(v);
-              for (; i < order.size() && order[i].first == gid[v]; ++i)
-              {
-                const std::vector<vtkIdType>& in = incoming[order[i].second];
-                std::size_t& at = cursor[order[i].second];
-                const vtkIdType count = at < in.size() ? in[at++] : 0;
-                for (vtkIdType j = 0; j < count && at + 5 < in.size(); ++j, at += 6)
-                {
-                  terms.push_back(Term{ { in[at], in[at + 1], in[at + 2] },
-                    { UnpackDouble(in[at + 3]), UnpackDouble(in[at + 4]),
-                      UnpackDouble(in[at + 5]) } });
-                }
-              }
-              sum(&n[3 * v]);
-            }
+            this->SumOwnTerms(sums);
+            this->SumSharedTerms(received, sums);
           }))
     {
       return {};
     }
-    this->Update(n.data(), NormalBackTag);
-    if (!this->R.Step("compute normals", problem, [&]() { normals.assign(n.begin(), n.end()); }))
+    this->Update(sums.data(), NormalBackTag);
+    if (!this->AllRanks.Step(
+          "compute normals", problem, [&]() { normals.assign(sums.begin(), sums.end()); }))
     {
       return {};
     }
@@ -1155,15 +679,666 @@ public:
   std::vector<T> Smoothed; // positions of this rank's vertices after smoothing
 
 private:
+  /// A neighbour held elsewhere, until the remote slots are numbered.
+  struct Pending
+  {
+    vtkIdType Gid;
+    int Provider;
+    double X[3];
+  };
+
+  /// The edges that other ranks sent to this owner, read in order.
+  struct ReceivedEdges
+  {
+    const std::vector<std::vector<vtkIdType>>& FromRank;
+    std::vector<std::size_t> Cursor; // per rank
+  };
+
+  /// A triangle's contribution to a vertex normal: its sorted global ids, and its area vector
+  /// taken from its corner of smallest global id (orientation kept), so that every rank
+  /// computes the same bits.
+  struct NormalTerm
+  {
+    std::array<vtkIdType, 3> Key;
+    double Cross[3];
+    bool operator<(const NormalTerm& o) const { return this->Key < o.Key; }
+  };
+
+  // -- the seams ---------------------------------------------------------------------------
+
+  /// Edges at shared vertices go to their owners (shared vertices in gid order: each owner
+  /// receives them in its own order): per vertex, its gid, its number of edges, and per edge
+  /// the neighbour's gid, the edge's triangles here, the neighbour's volume faces and position.
+  void ListSeamEdges(std::vector<std::vector<vtkIdType>>& toOwners)
+  {
+    for (std::size_t i = 0; i < this->Numbering.SharedVertex.size(); ++i)
+    {
+      const int owner = this->Numbering.SharedOwner[i];
+      if (owner == this->AllRanks.Rank)
+      {
+        continue;
+      }
+      const vtkIdType v = this->Numbering.SharedVertex[i];
+      this->Around.clear();
+      this->LocalNeighbours(v, this->Around);
+      rgmc::MessageWriter out(toOwners[owner]);
+      out.Int(this->Numbering.Gid[v]).Int(static_cast<std::int64_t>(this->Around.size()));
+      for (const Neighbour& nb : this->Around)
+      {
+        const T* x = this->Positions + 3 * nb.Local;
+        out.Int(nb.Gid).Int(nb.Uses).Int(this->MaskOf(nb.Local));
+        out.Real(static_cast<double>(x[0]))
+          .Real(static_cast<double>(x[1]))
+          .Real(static_cast<double>(x[2]));
+      }
+    }
+  }
+
+  /// Every vertex this rank owns, in gid order: its whole neighbourhood, its edges in the
+  /// checks, its stencil row. Then the corner lists are released.
+  void AssembleNeighbourhoods(
+    const std::vector<std::vector<vtkIdType>>& received, bool stencils, Checks& checks)
+  {
+    ReceivedEdges edges{ received, std::vector<std::size_t>(this->AllRanks.Size, 0) };
+    this->CosEdgeAngle = std::cos(vtkMath::RadiansFromDegrees(15.0));
+    if (stencils)
+    {
+      this->Owned.reserve(static_cast<std::size_t>(this->NumVertices));
+      this->Stencil.Offsets.reserve(static_cast<std::size_t>(this->NumVertices) + 1);
+      this->Stencil.Neighbours.reserve(static_cast<std::size_t>(3 * this->NumTriangles));
+    }
+    this->AddUnsharedVertices(stencils, checks);
+    // Shared vertices this rank owns, in gid order (the order of the received edges).
+    for (std::size_t i = 0; i < this->Numbering.SharedVertex.size(); ++i)
+    {
+      if (this->Numbering.SharedOwner[i] == this->AllRanks.Rank)
+      {
+        this->AddVertex(this->Numbering.SharedVertex[i], i, &edges, stencils, checks);
+      }
+    }
+    std::vector<vtkIdType>().swap(this->Corners);
+    std::vector<vtkIdType>().swap(this->CornerOffsets);
+  }
+
+  /// Vertices no other rank holds, in memory order: most are inside a closed manifold piece of
+  /// the surface, where every edge has two triangles and the stencil is simply the neighbours
+  /// in gid order. Those are found on threads, in blocks of vertices (each block's rows kept
+  /// apart), then taken block by block in order, the others going through AddVertex there: the
+  /// same rows, in the same order, for any number of threads.
+  void AddUnsharedVertices(bool stencils, Checks& checks)
+  {
+    if (vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
+    {
+      // One thread: straight into the stencils.
+      for (vtkIdType v = 0; v < this->NumVertices; ++v)
+      {
+        if (this->Numbering.Holding[v] != GlobalNumbering::Alone)
+        {
+          continue;
+        }
+        if (!this->ManifoldRow(v, stencils, this->Ends, this->Stencil.Neighbours, checks.Edges))
+        {
+          this->AddVertex(v, 0, nullptr, stencils, checks);
+        }
+        else if (stencils)
+        {
+          this->CloseRow(v);
+        }
+      }
+      return;
+    }
+    struct Block
+    {
+      std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex AddVertex takes
+      std::vector<vtkIdType> Ends;     // row ends in Neighbours, per manifold vertex
+      std::vector<std::int64_t> Neighbours;
+      vtkIdType Edges = 0;
+    };
+    // Batches of blocks bound the rows held apart (memory), whatever the mesh's size.
+    const vtkIdType blockSize = 4096, batchBlocks = 64;
+    const vtkIdType numBlocks = (this->NumVertices + blockSize - 1) / blockSize;
+    std::vector<Block> blocks;
+    for (vtkIdType batch = 0; batch < numBlocks; batch += batchBlocks)
+    {
+      blocks.assign(static_cast<std::size_t>(std::min(batchBlocks, numBlocks - batch)), Block());
+      rgmc::ParallelFor(static_cast<vtkIdType>(blocks.size()), 1,
+        [&](vtkIdType first, vtkIdType last)
+        {
+          std::vector<std::pair<vtkIdType, vtkIdType>> blockEnds;
+          for (vtkIdType b = first; b < last; ++b)
+          {
+            Block& block = blocks[b];
+            const vtkIdType start = (batch + b) * blockSize;
+            for (vtkIdType v = start; v < std::min(this->NumVertices, start + blockSize); ++v)
+            {
+              if (this->Numbering.Holding[v] != GlobalNumbering::Alone)
+              {
+                continue;
+              }
+              const bool manifold =
+                this->ManifoldRow(v, stencils, blockEnds, block.Neighbours, block.Edges);
+              block.Vertices.push_back(manifold ? v : -1 - v);
+              if (manifold)
+              {
+                block.Ends.push_back(static_cast<vtkIdType>(block.Neighbours.size()));
+              }
+            }
+          }
+        });
+      for (Block& block : blocks)
+      {
+        checks.Edges += block.Edges;
+        std::size_t row = 0;
+        vtkIdType begin = 0;
+        for (const vtkIdType entry : block.Vertices)
+        {
+          if (entry < 0)
+          {
+            this->AddVertex(-1 - entry, 0, nullptr, stencils, checks);
+            continue;
+          }
+          const vtkIdType end = block.Ends[row++];
+          if (stencils)
+          {
+            this->Stencil.Neighbours.insert(this->Stencil.Neighbours.end(),
+              block.Neighbours.begin() + begin, block.Neighbours.begin() + end);
+            this->CloseRow(entry);
+          }
+          begin = end;
+        }
+        block = Block();
+      }
+    }
+  }
+
+  /// Whether vertex v (no other rank holds it) is inside a manifold piece; if so, its edges are
+  /// counted in `edges` and its row appended to `row` (when stencils are made). Reads only:
+  /// threads may call it at once, each with its own `ends`.
+  bool ManifoldRow(vtkIdType v, bool stencils, std::vector<std::pair<vtkIdType, vtkIdType>>& ends,
+    std::vector<std::int64_t>& row, vtkIdType& edges) const
+  {
+    this->EndsAt(v, ends);
+    bool manifold = !ends.empty() && ends.size() < 2 * 255;
+    for (std::size_t e = 0; e < ends.size() && manifold; e += 2)
+    {
+      manifold = e + 1 < ends.size() && ends[e + 1].first == ends[e].first &&
+        (e + 2 == ends.size() || ends[e + 2].first != ends[e].first);
+    }
+    if (!manifold)
+    {
+      return false;
+    }
+    for (std::size_t e = 0; e < ends.size(); e += 2)
+    {
+      edges += ends[e].first > this->Numbering.Gid[v];
+      if (stencils)
+      {
+        row.push_back(ends[e].second);
+      }
+    }
+    return true;
+  }
+
+  /// Any vertex: its whole neighbourhood (with the edges other ranks sent, for a shared one:
+  /// `received`, at shared index `sharedIndex`), its edges in the checks, its stencil.
+  void AddVertex(
+    vtkIdType v, std::size_t sharedIndex, ReceivedEdges* received, bool stencils, Checks& checks)
+  {
+    this->Around.clear();
+    this->LocalNeighbours(v, this->Around);
+    if (received)
+    {
+      this->AddReceivedEdges(v, sharedIndex, *received);
+    }
+    this->CountEdges(v, checks);
+    if (stencils)
+    {
+      this->AddStencilRow(v);
+    }
+  }
+
+  /// Adds the edges the other holders of shared vertex v sent to Around, and merges the ranks'
+  /// counts of each edge (keeping the local copy of the neighbour).
+  void AddReceivedEdges(vtkIdType v, std::size_t sharedIndex, ReceivedEdges& received)
+  {
+    const vtkIdType gid = this->Numbering.Gid[v];
+    for (vtkIdType h = this->Numbering.SharerOffsets[sharedIndex];
+         h < this->Numbering.SharerOffsets[sharedIndex + 1]; ++h)
+    {
+      const int s = this->Numbering.Sharers[h];
+      const std::vector<vtkIdType>& in = received.FromRank[s];
+      std::size_t& i = received.Cursor[s];
+      if (i + 1 >= in.size() || in[i] != gid)
+      {
+        continue;
+      }
+      rgmc::MessageReader edges(in.data() + i, in.size() - i);
+      edges.Int(); // the vertex's gid, checked above
+      const std::int64_t count = edges.Int();
+      for (std::int64_t j = 0; j < count; ++j)
+      {
+        Neighbour nb{ edges.Int(), 0, -1, s, 0, { 0, 0, 0 } };
+        nb.Uses = static_cast<int>(edges.Int());
+        nb.Mask = static_cast<int>(edges.Int());
+        for (double& x : nb.X)
+        {
+          x = edges.Real();
+        }
+        this->Around.push_back(nb);
+      }
+      i += edges.Position();
+    }
+    std::stable_sort(this->Around.begin(), this->Around.end(),
+      [](const Neighbour& a, const Neighbour& b) { return a.Gid < b.Gid; });
+    std::vector<Neighbour>& all = this->Around;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < all.size(); ++i)
+    {
+      if (kept > 0 && all[kept - 1].Gid == all[i].Gid)
+      {
+        all[kept - 1].Uses += all[i].Uses;
+        if (all[kept - 1].Local < 0 && all[i].Local >= 0)
+        {
+          all[kept - 1] = Neighbour{ all[i].Gid, all[kept - 1].Uses, all[i].Local,
+            this->AllRanks.Rank, 0, { 0, 0, 0 } };
+        }
+      }
+      else
+      {
+        all[kept++] = all[i];
+      }
+    }
+    this->Around.resize(kept);
+  }
+
+  /// The distinct edges of Around into Incident, each counted once in the checks (at its end
+  /// of smaller gid): boundary edges (one triangle) apart from those along the volume's border,
+  /// and non-manifold ones (more than two).
+  void CountEdges(vtkIdType v, Checks& checks)
+  {
+    const int myMask = this->MaskOf(v);
+    this->Incident.clear();
+    for (const Neighbour& nb : this->Around)
+    {
+      this->Incident.push_back(rgmc::IncidentEdge{ nb.Gid, nb.Uses });
+      if (nb.Gid > this->Numbering.Gid[v])
+      {
+        ++checks.Edges;
+        if (nb.Uses == 1)
+        {
+          const int mask = nb.Local >= 0 ? this->MaskOf(nb.Local) : nb.Mask;
+          ++((myMask & mask) ? checks.Border : checks.Boundary);
+        }
+        else if (nb.Uses > 2)
+        {
+          ++checks.NonManifold;
+        }
+      }
+    }
+  }
+
+  /// Vertex v's stencil row, from Around and Incident; a neighbour held elsewhere is pending
+  /// until the remote slots are numbered.
+  void AddStencilRow(vtkIdType v)
+  {
+    auto find = [this](vtkIdType g) -> const Neighbour&
+    {
+      return *std::lower_bound(this->Around.begin(), this->Around.end(), g,
+        [](const Neighbour& nb, vtkIdType key) { return nb.Gid < key; });
+    };
+    auto position = [this](const Neighbour& nb, T x[3])
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        x[k] = nb.Local >= 0 ? this->Positions[3 * nb.Local + k] : static_cast<T>(nb.X[k]);
+      }
+    };
+    rgmc::SmoothingStencil(
+      this->Incident,
+      [&](std::int64_t a, std::int64_t b)
+      {
+        T pa[3], pb[3];
+        position(find(a), pa);
+        position(find(b), pb);
+        return rgmc::ExceedsEdgeAngle(pa, this->Positions + 3 * v, pb, this->CosEdgeAngle);
+      },
+      this->Row);
+    this->Owned.push_back(v);
+    for (std::int64_t g : this->Row)
+    {
+      const Neighbour& nb = find(g);
+      if (nb.Local >= 0)
+      {
+        this->Stencil.Neighbours.push_back(nb.Local);
+        continue;
+      }
+      this->Stencil.Neighbours.push_back(
+        -1 - static_cast<std::int64_t>(this->PendingRemote.size()));
+      this->PendingRemote.push_back(Pending{ nb.Gid, nb.Provider, { nb.X[0], nb.X[1], nb.X[2] } });
+    }
+    this->Stencil.Offsets.push_back(static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+  }
+
+  /// Ends the stencil row of vertex v, whose neighbours are appended.
+  void CloseRow(vtkIdType v)
+  {
+    this->Owned.push_back(v);
+    this->Stencil.Offsets.push_back(static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
+  }
+
+  /// The neighbours held elsewhere get slots NumVertices, NumVertices + 1, ... in gid order.
+  void NumberRemoteNeighbours()
+  {
+    const std::vector<Pending>& pending = this->PendingRemote;
+    std::vector<vtkIdType> order(pending.size()), slotOf(pending.size());
+    std::iota(order.begin(), order.end(), vtkIdType(0));
+    std::sort(order.begin(), order.end(),
+      [&pending](vtkIdType a, vtkIdType b) { return pending[a].Gid < pending[b].Gid; });
+    for (vtkIdType o : order)
+    {
+      const Pending& p = pending[o];
+      if (this->RemoteGids.empty() || this->RemoteGids.back() != p.Gid)
+      {
+        this->RemoteGids.push_back(p.Gid);
+        this->RemoteProviders.push_back(p.Provider);
+        this->RemoteInitial.insert(this->RemoteInitial.end(), p.X, p.X + 3);
+      }
+      slotOf[o] = static_cast<vtkIdType>(this->RemoteGids.size()) - 1;
+    }
+    for (std::int64_t& s : this->Stencil.Neighbours)
+    {
+      s = s < 0 ? this->NumVertices + slotOf[-1 - s] : s;
+    }
+    std::vector<Pending>().swap(this->PendingRemote);
+  }
+
+  /// Who sends what each iteration: the neighbours owners lack, from ranks that hold them; the
+  /// owners' new positions, to the other holders (both sides list a pair's vertices in gid
+  /// order).
+  void ListSharedVertices()
+  {
+    for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
+    {
+      this->RequestLists[this->RemoteProviders[r]].push_back(this->RemoteGids[r]);
+      this->RemoteOrder[this->RemoteProviders[r]].push_back(
+        this->NumVertices + static_cast<vtkIdType>(r));
+    }
+    for (std::size_t i = 0; i < this->Numbering.SharedVertex.size(); ++i)
+    {
+      const vtkIdType v = this->Numbering.SharedVertex[i];
+      if (this->Numbering.SharedOwner[i] == this->AllRanks.Rank)
+      {
+        for (vtkIdType h = this->Numbering.SharerOffsets[i];
+             h < this->Numbering.SharerOffsets[i + 1]; ++h)
+        {
+          this->ToSharer[this->Numbering.Sharers[h]].push_back(v);
+        }
+      }
+      else
+      {
+        this->FromOwner[this->Numbering.SharedOwner[i]].push_back(v);
+      }
+    }
+  }
+
+  /// The vertices each rank asked this one to send every iteration.
+  void ListProvided(const std::vector<std::vector<vtkIdType>>& asked)
+  {
+    for (int s = 0; s < this->AllRanks.Size; ++s)
+    {
+      for (vtkIdType g : asked[s])
+      {
+        this->Provide[s].push_back(this->VertexOfGid(g));
+      }
+    }
+  }
+
+  // -- smoothing ---------------------------------------------------------------------------
+
+  /// Jacobi Laplacian, in double, rounded once at the end.
+  bool SmoothLaplacian(const SmoothingSettings& settings,
+    const std::function<bool(double)>& progress, bool& aborted, std::string& problem)
+  {
+    const std::size_t size = 3 * (this->NumVertices + this->RemoteGids.size());
+    std::vector<double> current, next;
+    if (!this->AllRanks.Step("smooth the surface", problem,
+          [&]()
+          {
+            current.resize(size);
+            next.resize(size);
+            std::copy(this->Positions, this->Positions + 3 * this->NumVertices, current.begin());
+            std::copy(this->RemoteInitial.begin(), this->RemoteInitial.end(),
+              current.begin() + 3 * this->NumVertices);
+          }))
+    {
+      return false;
+    }
+    for (int it = 0; it < settings.Iterations && !aborted; ++it)
+    {
+      if (progress(double(it) / settings.Iterations))
+      {
+        aborted = true;
+        break;
+      }
+      this->Fetch(current.data());
+      rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
+        [&](vtkIdType first, vtkIdType last)
+        {
+          rgmc::LaplacianStep(this->Stencil, this->Owned, current.data(), next.data(),
+            settings.Relaxation, first, last);
+        });
+      this->Update(next.data());
+      std::swap(current, next);
+    }
+    std::vector<double>().swap(next);
+    return this->AllRanks.Step("smooth the surface", problem,
+      [&]() { this->Smoothed.assign(current.begin(), current.begin() + 3 * this->NumVertices); });
+  }
+
+  /// Windowed sinc, in the points' type, as VTK's filter: x0, x1, x2 the last three states,
+  /// `sum` the result.
+  bool SmoothWindowedSinc(const SmoothingSettings& settings,
+    const std::function<bool(double)>& progress, bool& aborted, std::string& problem)
+  {
+    const std::size_t size = 3 * (this->NumVertices + this->RemoteGids.size());
+    std::vector<T> a, b, c, sum;
+    std::vector<double> coefficients;
+    if (!this->AllRanks.Step("smooth the surface", problem,
+          [&]()
+          {
+            a.resize(size);
+            b.resize(size);
+            std::copy(this->Positions, this->Positions + 3 * this->NumVertices, a.begin());
+            for (std::size_t r = 0; r < this->RemoteGids.size(); ++r)
+            {
+              for (int k = 0; k < 3; ++k)
+              {
+                a[3 * (this->NumVertices + r) + k] = static_cast<T>(this->RemoteInitial[3 * r + k]);
+              }
+            }
+            c.resize(size);
+            sum.resize(size);
+            coefficients =
+              rgmc::SincCoefficients(settings.Iterations, settings.PassBand, settings.Window);
+          }))
+    {
+      return false;
+    }
+    T* x0 = a.data();
+    T* x1 = b.data();
+    T* x2 = c.data();
+    this->Fetch(x0);
+    rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
+      [&](vtkIdType first, vtkIdType last)
+      {
+        rgmc::SincFirstStep(
+          this->Stencil, this->Owned, x0, x1, sum.data(), coefficients.data(), first, last);
+      });
+    this->Update(x1);
+    for (int it = 2; it <= settings.Iterations; ++it)
+    {
+      if (progress(double(it) / settings.Iterations))
+      {
+        aborted = true;
+        break;
+      }
+      this->Fetch(x1);
+      rgmc::ParallelFor(static_cast<vtkIdType>(this->Owned.size()), RowGrain,
+        [&](vtkIdType first, vtkIdType last)
+        {
+          rgmc::SincStep(
+            this->Stencil, this->Owned, x0, x1, x2, sum.data(), coefficients[it], first, last);
+        });
+      this->Update(x2);
+      T* oldest = x0;
+      x0 = x1;
+      x1 = x2;
+      x2 = oldest;
+    }
+    this->Update(sum.data());
+    this->Smoothed.swap(sum);
+    return true;
+  }
+
+  // -- normals -----------------------------------------------------------------------------
+
+  NormalTerm TermOf(vtkIdType t) const
+  {
+    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
+    const T* x = this->Smoothed.data();
+    vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
+      static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
+      static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
+    const int first =
+      gid[c[0]] < gid[c[1]] ? (gid[c[0]] < gid[c[2]] ? 0 : 2) : (gid[c[1]] < gid[c[2]] ? 1 : 2);
+    std::rotate(c, c + first, c + 3);
+    NormalTerm out;
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
+      e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
+    }
+    vtkMath::Cross(e1, e2, out.Cross);
+    out.Key = { gid[c[0]], gid[c[1]], gid[c[2]] };
+    std::sort(out.Key.begin(), out.Key.end());
+    return out;
+  }
+
+  /// The terms of this rank's triangles at vertex v, into `terms`.
+  void LocalTerms(vtkIdType v, std::vector<NormalTerm>& terms) const
+  {
+    terms.clear();
+    for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
+    {
+      terms.push_back(this->TermOf(this->Corners[c] / 3));
+    }
+  }
+
+  /// The normal of a vertex: its terms summed in the order of their keys.
+  static void SumTerms(std::vector<NormalTerm>& terms, double n[3])
+  {
+    std::sort(terms.begin(), terms.end());
+    n[0] = n[1] = n[2] = 0;
+    for (const NormalTerm& t : terms)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        n[k] += t.Cross[k];
+      }
+    }
+    vtkMath::Normalize(n);
+  }
+
+  /// The terms of shared vertices go to their owners (in gid order, as the owners list them).
+  void ListSharedTerms(std::vector<std::vector<vtkIdType>>& toOwners) const
+  {
+    std::vector<NormalTerm> terms;
+    for (int o = 0; o < this->AllRanks.Size; ++o)
+    {
+      rgmc::MessageWriter out(toOwners[o]);
+      for (vtkIdType v : this->FromOwner[o])
+      {
+        this->LocalTerms(v, terms);
+        out.Int(static_cast<std::int64_t>(terms.size()));
+        for (const NormalTerm& t : terms)
+        {
+          out.Int(t.Key[0]).Int(t.Key[1]).Int(t.Key[2]);
+          out.Real(t.Cross[0]).Real(t.Cross[1]).Real(t.Cross[2]);
+        }
+      }
+    }
+  }
+
+  /// Each vertex's own terms, on threads (each range with its own list of terms).
+  void SumOwnTerms(std::vector<double>& sums) const
+  {
+    rgmc::ParallelFor(this->NumVertices, RowGrain,
+      [&](vtkIdType first, vtkIdType last)
+      {
+        std::vector<NormalTerm> own;
+        for (vtkIdType v = first; v < last; ++v)
+        {
+          this->LocalTerms(v, own);
+          SumTerms(own, &sums[3 * v]);
+        }
+      });
+  }
+
+  /// Owned shared vertices: their own terms and every holder's, in the same order.
+  void SumSharedTerms(
+    const std::vector<std::vector<vtkIdType>>& received, std::vector<double>& sums) const
+  {
+    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
+    std::vector<std::size_t> cursor(this->AllRanks.Size, 0);
+    std::vector<std::pair<vtkIdType, int>> order; // (gid, sharer) of owned shared vertices
+    for (int s = 0; s < this->AllRanks.Size; ++s)
+    {
+      if (s != this->AllRanks.Rank)
+      {
+        for (vtkIdType v : this->ToSharer[s])
+        {
+          order.emplace_back(gid[v], s);
+        }
+      }
+    }
+    std::sort(order.begin(), order.end());
+    std::vector<NormalTerm> terms;
+    for (std::size_t i = 0; i < order.size();)
+    {
+      const vtkIdType v = this->VertexOfGid(order[i].first);
+      this->LocalTerms(v, terms);
+      for (; i < order.size() && order[i].first == gid[v]; ++i)
+      {
+        const std::vector<vtkIdType>& in = received[order[i].second];
+        std::size_t& at = cursor[order[i].second];
+        const vtkIdType count = at < in.size() ? in[at++] : 0;
+        for (vtkIdType j = 0; j < count && at + 5 < in.size(); ++j, at += 6)
+        {
+          rgmc::MessageReader term(in.data() + at, 6);
+          NormalTerm t;
+          t.Key = { term.Int(), term.Int(), term.Int() };
+          t.Cross[0] = term.Real();
+          t.Cross[1] = term.Real();
+          t.Cross[2] = term.Real();
+          terms.push_back(t);
+        }
+      }
+      SumTerms(terms, &sums[3 * v]);
+    }
+  }
+
+  // -- helpers -----------------------------------------------------------------------------
+
   /// The triangle corners (3 t + k) at each vertex, in compressed rows.
   void CornersAround(std::vector<vtkIdType>& offsets, std::vector<vtkIdType>& corners) const
   {
-    offsets.assign(static_cast<std::size_t>(this->N) + 1, 0);
+    offsets.assign(static_cast<std::size_t>(this->NumVertices) + 1, 0);
     for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
     {
       ++offsets[static_cast<vtkIdType>(this->Triangles[c]) + 1];
     }
-    for (vtkIdType v = 0; v < this->N; ++v)
+    for (vtkIdType v = 0; v < this->NumVertices; ++v)
     {
       offsets[v + 1] += offsets[v];
     }
@@ -1175,21 +1350,56 @@ private:
     }
   }
 
+  /// The ends of this rank's edges at vertex v (once per triangle side), as (gid, vertex)
+  /// sorted by gid, into `out`. Reads only: threads may call it at once.
+  void EndsAt(vtkIdType v, std::vector<std::pair<vtkIdType, vtkIdType>>& out) const
+  {
+    out.clear();
+    for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
+    {
+      const vtkIdType t = this->Corners[c] / 3, k = this->Corners[c] % 3;
+      for (vtkIdType other : { (k + 1) % 3, (k + 2) % 3 })
+      {
+        const vtkIdType w = static_cast<vtkIdType>(this->Triangles[3 * t + other]);
+        out.emplace_back(this->Numbering.Gid[w], w);
+      }
+    }
+    std::sort(out.begin(), out.end());
+  }
+
+  /// This rank's edges at vertex v, sorted by the neighbour's gid, appended to `out`.
+  void LocalNeighbours(vtkIdType v, std::vector<Neighbour>& out)
+  {
+    this->EndsAt(v, this->Ends);
+    const std::vector<std::pair<vtkIdType, vtkIdType>>& ends = this->Ends;
+    for (std::size_t e = 0; e < ends.size();)
+    {
+      std::size_t end = e;
+      while (end < ends.size() && ends[end].first == ends[e].first)
+      {
+        ++end;
+      }
+      out.push_back(Neighbour{ ends[e].first, static_cast<int>(end - e), ends[e].second,
+        this->AllRanks.Rank, 0, { 0, 0, 0 } });
+      e = end;
+    }
+  }
+
   int MaskOf(vtkIdType v) const
   {
-    const T* x = this->X + 3 * v;
+    const T* x = this->Positions + 3 * v;
     const double p[3] = { static_cast<double>(x[0]), static_cast<double>(x[1]),
       static_cast<double>(x[2]) };
     return this->Border.Mask(
-      this->Grid, this->Keys ? this->Keys[this->Local.PointOf(v)] : vtkIdType(0), p);
+      this->Grid, this->Keys ? this->Keys[this->Vertices.PointOf(v)] : vtkIdType(0), p);
   }
 
   /// The vertex with global id `g` (this rank holds it): its vertices in identity order are in
   /// gid order.
   vtkIdType VertexOfGid(vtkIdType g) const
   {
-    const std::vector<vtkIdType>& gid = this->Num.Gid;
-    return *std::lower_bound(this->Local.Sorted.begin(), this->Local.Sorted.end(), g,
+    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
+    return *std::lower_bound(this->Vertices.Sorted.begin(), this->Vertices.Sorted.end(), g,
       [&gid](vtkIdType v, vtkIdType key) { return gid[v] < key; });
   }
 
@@ -1199,16 +1409,16 @@ private:
   void Share(const std::vector<std::vector<vtkIdType>>& send,
     const std::vector<std::vector<vtkIdType>>& receive, S* state, int tag)
   {
-    std::vector<std::vector<double>> out(this->R.Size);
-    for (int r = 0; r < this->R.Size; ++r)
+    std::vector<std::vector<double>> out(this->AllRanks.Size);
+    for (int r = 0; r < this->AllRanks.Size; ++r)
     {
       for (vtkIdType v : send[r])
       {
         out[r].insert(out[r].end(), state + 3 * v, state + 3 * v + 3);
       }
     }
-    const auto in = this->R.Exchange(out, this->Partners, tag);
-    for (int r = 0; r < this->R.Size; ++r)
+    const auto in = this->AllRanks.Exchange(out, this->Partners, tag);
+    for (int r = 0; r < this->AllRanks.Size; ++r)
     {
       const std::vector<vtkIdType>& list = receive[r];
       for (std::size_t i = 0; i < list.size() && 3 * i + 2 < in[r].size(); ++i)
@@ -1235,17 +1445,27 @@ private:
     this->Share(this->ToSharer, this->FromOwner, state, tag);
   }
 
-  Ranks& R;
-  const LocalVertices& Local;
-  const Numbering& Num;
+  Ranks& AllRanks;
+  const LocalVertices& Vertices;
+  const GlobalNumbering& Numbering;
   const BorderTest Border;
   const rgmc::Grid Grid;
   const vtkIdType* Keys; // the input's vertex keys, or null
-  const T* X;            // positions of this rank's vertices
+  const T* Positions;    // of this rank's vertices
   const I* Triangles;    // over this rank's vertices
   const vtkIdType NumTriangles;
-  const vtkIdType N;
+  const vtkIdType NumVertices;
   std::vector<bool> Partners; // the ranks that share a vertex with this one
+
+  // The triangle corners at each vertex (while the seams are analysed, and for the normals).
+  std::vector<vtkIdType> CornerOffsets, Corners;
+  // One vertex's neighbourhood while it is analysed (on the calling thread).
+  std::vector<std::pair<vtkIdType, vtkIdType>> Ends;
+  std::vector<Neighbour> Around;
+  std::vector<rgmc::IncidentEdge> Incident;
+  std::vector<std::int64_t> Row;
+  double CosEdgeAngle = 1.0;
+  std::vector<Pending> PendingRemote;
 
   std::vector<std::int64_t> Owned; // the vertices this rank moves, one stencil row each
   rgmc::Stencils Stencil;
@@ -1274,327 +1494,376 @@ vtkRGSeamRepair::~vtkRGSeamRepair()
 }
 
 //------------------------------------------------------------------------------
+/// What one execution carries from pass to pass on this rank.
+struct vtkRGSeamRepair::Run
+{
+  Run(vtkMultiProcessController* controller, vtkPolyData* input)
+    : ranks(controller)
+    , input(input)
+  {
+  }
+  Ranks ranks;
+  std::string problem; // the agreed error of a failed pass
+  vtkPolyData* input;
+  vtkIdType triangles = 0;         // over all ranks
+  const vtkIdType* keys = nullptr; // the input's vertex keys, when every rank has them
+  LocalVertices vertices;
+  GlobalNumbering numbering;
+  BorderTest border;
+  bool smooth = false;
+  std::vector<vtkIdType> connectivity; // the triangles over the vertices, when merged or copied
+  vtkNew<vtkPoints> points;            // the output's
+  std::vector<float> normals;          // after smoothing
+  Checks checks;                       // this rank's counts, then the sums over all ranks
+  bool aborted = false;
+};
+
+//------------------------------------------------------------------------------
+// The collective schedule: every rank runs these passes in this order and makes the same
+// collective calls in each (an agreement is one collective call on success, one or two
+// broadcasts more on failure); a pass that fails returns on every rank at the same point.
+// "Exchange" is Ranks::Exchange: with every rank in NumberVertices, else with the ranks that
+// share a vertex with this one.
+//
+//  PASS 0 CheckInput      agreement (a triangle mesh), AllReduce (triangles), agreement
+//  PASS 1 NumberVertices  AllReduce (whether every rank has vertex keys), agreement (the
+//                         local sort); IdentityNumbering: AllGather, AllGatherV, agreement,
+//                         exchange, agreement, AllGather, exchange, agreement
+//  PASS 2 FindBorder      2 AllReduce (the bounds)
+//  PASS 3 RepairSeams     agreement (the input copied); AnalyzeSeams: agreement, exchange,
+//                         agreement, exchange, agreement
+//  PASS 4                 smoothing only: per iteration an AllReduce (abort) and two
+//                         exchanges, an agreement or two; Normals: agreement, exchange,
+//                         agreement, exchange, agreement
+//  PASS 5                 agreement (the output points)
+//  PASS 6 StoreSurface    AllReduce (the checks), agreement (the output)
+//         ReportChecks    none
 int vtkRGSeamRepair::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkPolyData* input = vtkPolyData::GetData(inputVector[0]);
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
-  vtkNew<vtkDummyController> single;
-  Ranks ranks(this->Controller ? this->Controller : single.Get());
   // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
   // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
   // SetAbortExecute would mark the filter modified and make it run again.
   this->AbortExecute = 0;
+  vtkNew<vtkDummyController> single;
+  Run run(this->Controller ? this->Controller : single.Get(), vtkPolyData::GetData(inputVector[0]));
+  // The count of this run's collective calls, however it ends.
+  struct Accounting
+  {
+    vtkRGSeamRepair* Filter;
+    Run& Counted;
+    ~Accounting() { this->Filter->NumberOfCollectives = this->Counted.ranks.Collectives; }
+  } accounting{ this, run };
 
-  // PASS 0: a triangle mesh, on every rank.
-  std::string problem;
+  // PASS 0: a triangle mesh with triangles, on every rank.
+  if (!this->CheckInput(run))
   {
-    std::ostringstream msg;
-    const vtkIdType verts = input->GetNumberOfVerts(), lines = input->GetNumberOfLines(),
-                    strips = input->GetNumberOfStrips();
-    vtkIdType other = 0;
-    vtkCellArray* polys = input->GetPolys();
-    vtkIdType npts;
-    const vtkIdType* pts;
-    for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
-    {
-      other += npts != 3;
-    }
-    if (verts || lines || strips || other)
-    {
-      msg << "the input is not a triangle mesh: it has " << verts << " vertex cells, " << lines
-          << " lines, " << strips << " triangle strips and " << other
-          << " polygons that are not triangles (apply Triangulate, or Extract Surface, first)";
-    }
-    problem = msg.str();
-  }
-  if (!ranks.Agree(problem.empty(), problem))
-  {
-    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
-    return 0;
-  }
-  vtkIdType localTriangles = input->GetNumberOfPolys(), triangles = 0;
-  ranks.Check(ranks.C->AllReduce(&localTriangles, &triangles, 1, vtkCommunicator::SUM_OP),
-    "counting triangles");
-  if (!ranks.Agree(triangles > 0, problem))
-  {
-    vtkErrorMacro(<< "Cannot repair the seams: "
-                  << (problem.empty() ? std::string("the input has no triangles") : problem)
-                  << ".");
+    vtkErrorMacro(<< "Cannot repair the seams: " << run.problem << ".");
     return 0;
   }
   this->UpdateProgress(0.05);
-
-  // PASS 1: this rank's distinct vertices and their global numbering. Identities are global ids
-  // when every rank with points has them, else exact coordinates.
-  vtkIdTypeArray* keyArray = vtkIdTypeArray::SafeDownCast(input->GetPointData()->GetGlobalIds());
-  int keyed = input->GetNumberOfPoints() == 0 || keyArray ? 1 : 0, allKeyed = 0;
-  ranks.Check(ranks.C->AllReduce(&keyed, &allKeyed, 1, vtkCommunicator::MIN_OP),
-    "agreeing on vertex identities");
-  const vtkIdType* keys = allKeyed && keyArray ? keyArray->GetPointer(0) : nullptr;
-  LocalVertices local;
-  Numbering numbering;
-  auto number = [&](auto words)
+  // PASS 1: this rank's distinct vertices and their global numbering.
+  if (!this->NumberVertices(run))
   {
-    constexpr int Words = decltype(words)::value;
-    std::vector<Identity<Words>> ids;
-    return ranks.Step("sort the vertices", problem,
-             [&]() { local = MergeLocal<Words>(input, keys, ids); }) &&
-      Number<Words>(ranks, local, ids, numbering, problem);
-  };
-  if (!(allKeyed ? number(std::integral_constant<int, 1>())
-                 : number(std::integral_constant<int, 3>())))
-  {
-    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
+    vtkErrorMacro(<< "Cannot repair the seams: " << run.problem << ".");
     return 0;
   }
   this->UpdateProgress(0.25);
-
-  // How to tell edges on the volume's border: from keys and the whole extent when the input
-  // came from vtkRGMarchingCubes, else from the global bounds.
-  BorderTest border;
+  // PASS 2: how to tell edges on the volume's border.
+  this->FindBorder(run);
+  // PASS 3-5: edges at the seams, checks, smoothing, normals, the output points.
+  if (!this->RepairSeams(run))
   {
-    double b[6], lo[3], hi[3], glo[3], ghi[3];
-    input->GetBounds(b);
-    for (int a = 0; a < 3; ++a)
+    output->Initialize();
+    if (run.aborted)
     {
-      lo[a] = input->GetNumberOfPoints() ? b[2 * a] : VTK_DOUBLE_MAX;
-      hi[a] = input->GetNumberOfPoints() ? b[2 * a + 1] : VTK_DOUBLE_MIN;
+      return 1;
     }
-    ranks.Check(ranks.C->AllReduce(lo, glo, 3, vtkCommunicator::MIN_OP), "reducing bounds");
-    ranks.Check(ranks.C->AllReduce(hi, ghi, 3, vtkCommunicator::MAX_OP), "reducing bounds");
-    double diagonal = 0;
-    for (int a = 0; a < 3; ++a)
+    vtkErrorMacro(<< "Cannot repair the seams: " << run.problem << ".");
+    return 0;
+  }
+  // PASS 6: the global checks and the output piece.
+  if (!this->StoreSurface(run, output))
+  {
+    vtkErrorMacro(<< "Cannot repair the seams: " << run.problem << ".");
+    output->Initialize();
+    return 0;
+  }
+  this->ReportChecks(run, output);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGSeamRepair::CheckInput(Run& run)
+{
+  Ranks& ranks = run.ranks;
+  vtkPolyData* input = run.input;
+  const vtkIdType verts = input->GetNumberOfVerts(), lines = input->GetNumberOfLines(),
+                  strips = input->GetNumberOfStrips();
+  vtkIdType other = 0;
+  vtkCellArray* polys = input->GetPolys();
+  vtkIdType npts;
+  const vtkIdType* pts;
+  for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+  {
+    other += npts != 3;
+  }
+  if (verts || lines || strips || other)
+  {
+    std::ostringstream msg;
+    msg << "the input is not a triangle mesh: it has " << verts << " vertex cells, " << lines
+        << " lines, " << strips << " triangle strips and " << other
+        << " polygons that are not triangles (apply Triangulate, or Extract Surface, first)";
+    run.problem = msg.str();
+  }
+  if (!ranks.Agree(run.problem.empty(), run.problem))
+  {
+    return false;
+  }
+  const vtkIdType localTriangles = input->GetNumberOfPolys();
+  ranks.AllReduce(
+    &localTriangles, &run.triangles, 1, vtkCommunicator::SUM_OP, "counting triangles");
+  if (!ranks.Agree(run.triangles > 0, run.problem))
+  {
+    run.problem = run.problem.empty() ? std::string("the input has no triangles") : run.problem;
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// Identities are global ids when every rank with points has them, else exact coordinates.
+bool vtkRGSeamRepair::NumberVertices(Run& run)
+{
+  Ranks& ranks = run.ranks;
+  vtkIdTypeArray* keyArray =
+    vtkIdTypeArray::SafeDownCast(run.input->GetPointData()->GetGlobalIds());
+  int keyed = run.input->GetNumberOfPoints() == 0 || keyArray ? 1 : 0, allKeyed = 0;
+  ranks.AllReduce(&keyed, &allKeyed, 1, vtkCommunicator::MIN_OP, "agreeing on vertex identities");
+  run.keys = allKeyed && keyArray ? keyArray->GetPointer(0) : nullptr;
+  auto number = [&run](auto words)
+  {
+    constexpr int Words = decltype(words)::value;
+    std::vector<Identity<Words>> ids;
+    return run.ranks.Step("sort the vertices", run.problem,
+             [&]() { run.vertices = MergeLocal<Words>(run.input, run.keys, ids); }) &&
+      IdentityNumbering<Words>(run.ranks, run.vertices, ids).Number(run.numbering, run.problem);
+  };
+  return allKeyed ? number(std::integral_constant<int, 1>())
+                  : number(std::integral_constant<int, 3>());
+}
+
+//------------------------------------------------------------------------------
+// From keys and the whole extent when the input came from vtkRGMarchingCubes, else from the
+// global bounds.
+void vtkRGSeamRepair::FindBorder(Run& run)
+{
+  vtkPolyData* input = run.input;
+  BorderTest& border = run.border;
+  double b[6], lo[3], hi[3], glo[3], ghi[3];
+  input->GetBounds(b);
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = input->GetNumberOfPoints() ? b[2 * a] : VTK_DOUBLE_MAX;
+    hi[a] = input->GetNumberOfPoints() ? b[2 * a + 1] : VTK_DOUBLE_MIN;
+  }
+  run.ranks.AllReduce(lo, glo, 3, vtkCommunicator::MIN_OP, "reducing bounds");
+  run.ranks.AllReduce(hi, ghi, 3, vtkCommunicator::MAX_OP, "reducing bounds");
+  double diagonal = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    border.Bounds[2 * a] = glo[a];
+    border.Bounds[2 * a + 1] = ghi[a];
+    diagonal += (ghi[a] - glo[a]) * (ghi[a] - glo[a]);
+  }
+  border.Tolerance = 1e-6 * std::sqrt(diagonal);
+  vtkIntArray* whole = vtkIntArray::SafeDownCast(input->GetFieldData()->GetArray("WholeExtent"));
+  if (run.keys && whole && whole->GetNumberOfValues() == 6)
+  {
+    border.Keys = true;
+    for (int i = 0; i < 6; ++i)
     {
-      border.Bounds[2 * a] = glo[a];
-      border.Bounds[2 * a + 1] = ghi[a];
-      diagonal += (ghi[a] - glo[a]) * (ghi[a] - glo[a]);
-    }
-    border.Tolerance = 1e-6 * std::sqrt(diagonal);
-    vtkIntArray* whole = vtkIntArray::SafeDownCast(input->GetFieldData()->GetArray("WholeExtent"));
-    if (keys && whole && whole->GetNumberOfValues() == 6)
-    {
-      border.Keys = true;
-      for (int i = 0; i < 6; ++i)
-      {
-        border.Whole[i] = whole->GetValue(i);
-      }
+      border.Whole[i] = whole->GetValue(i);
     }
   }
+}
 
-  // PASS 2-4: edges at the seams, checks, smoothing, normals; in the input points' precision,
-  // over the input's own connectivity when no points were merged.
-  const bool smooth = this->SmoothingMethod != NO_SMOOTHING && this->NumberOfIterations > 0;
-  const bool doublePoints = input->GetPoints() && input->GetPoints()->GetDataType() == VTK_DOUBLE;
-  vtkDataArray* inputConnectivity = input->GetPolys()->GetConnectivityArray();
-  std::vector<vtkIdType> connectivityCopy; // when the input's cannot be used as it is
-  vtkNew<vtkPoints> points;
-  std::vector<float> normals;
-  Checks checks;
-  bool aborted = false;
-  auto progress = [this, &ranks](double fraction)
-  {
-    this->UpdateProgress(0.4 + 0.5 * fraction);
-    return ranks.Any(this->CheckAbort());
-  };
-  auto run = [&](auto pointType, auto indexType) -> bool
-  {
-    using T = decltype(pointType);
-    using I = decltype(indexType);
-    const T* x = nullptr;
-    std::vector<T> xCopy;
-    const I* tris = nullptr;
-    if (!ranks.Step("copy the input", problem,
-          [&]()
-          {
-            using PointArray = vtkAOSDataArrayTemplate<T>;
-            PointArray* inputPoints = input->GetPoints()
-              ? PointArray::FastDownCast(input->GetPoints()->GetData())
-              : nullptr;
-            if (inputPoints && !local.Merged())
-            {
-              x = inputPoints->GetPointer(0);
-            }
-            else
-            {
-              xCopy.resize(static_cast<std::size_t>(3 * local.Count));
-              for (vtkIdType v = 0; v < local.Count; ++v)
-              {
-                double p[3];
-                input->GetPoint(local.PointOf(v), p);
-                for (int k = 0; k < 3; ++k)
-                {
-                  xCopy[3 * v + k] = static_cast<T>(p[k]);
-                }
-              }
-              x = xCopy.data();
-            }
-            using IndexArray = vtkAOSDataArrayTemplate<I>;
-            IndexArray* typed = IndexArray::FastDownCast(inputConnectivity);
-            if (typed && !local.Merged())
-            {
-              tris = typed->GetPointer(0); // every cell is a triangle (PASS 0)
-            }
-            else if constexpr (std::is_same<I, vtkIdType>::value)
-            {
-              connectivityCopy.reserve(static_cast<std::size_t>(3 * input->GetNumberOfPolys()));
-              vtkCellArray* polys = input->GetPolys();
-              vtkIdType npts;
-              const vtkIdType* pts;
-              for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
-              {
-                for (int k = 0; k < 3; ++k)
-                {
-                  connectivityCopy.push_back(local.VertexOf(pts[k]));
-                }
-              }
-              tris = connectivityCopy.data();
-            }
-          }))
-    {
-      return false;
-    }
-    Repair<T, I> repair(ranks, local, numbering, border, keys, x, tris, input->GetNumberOfPolys());
-    if (!repair.Analyze(smooth, checks, problem))
-    {
-      return false;
-    }
-    this->UpdateProgress(0.4);
-    if (smooth)
-    {
-      if (!repair.Smooth(this->SmoothingMethod, this->NumberOfIterations, this->RelaxationFactor,
-            this->PassBand,
-            this->WindowFunction == HAMMING_WINDOW ? rgmc::SincWindow::Hamming
-                                                   : rgmc::SincWindow::Nuttall,
-            progress, problem))
-      {
-        aborted = problem.empty();
-        return false;
-      }
-      normals = repair.Normals(problem);
-      if (normals.empty() && local.Count > 0)
-      {
-        return false;
-      }
-    }
-    // The output's points: the input's own when nothing moved and nothing was merged.
-    return ranks.Step("store the output points", problem,
-      [&]()
-      {
-        const std::vector<T>& moved = smooth ? repair.Smoothed : xCopy;
-        if (!smooth && !local.Merged())
-        {
-          points->ShallowCopy(input->GetPoints());
-          return;
-        }
-        vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
-        xyz->SetNumberOfComponents(3);
-        std::copy(moved.begin(), moved.begin() + 3 * local.Count,
-          rgmc::Allocate(xyz.Get(), 3 * local.Count));
-        points->SetData(xyz);
-      });
-  };
-  // A connectivity copy is always 64-bit; the input's own may be 32-bit.
-  const bool int32 = !local.Merged() && vtkTypeInt32Array::FastDownCast(inputConnectivity);
-  bool ok;
+//------------------------------------------------------------------------------
+// In the input points' precision, over the input's own connectivity when no points were merged
+// (a connectivity copy is always 64-bit; the input's own may be 32-bit).
+bool vtkRGSeamRepair::RepairSeams(Run& run)
+{
+  run.smooth = this->SmoothingMethod != NO_SMOOTHING && this->NumberOfIterations > 0;
+  vtkPoints* inputPoints = run.input->GetPoints();
+  const bool doublePoints = inputPoints && inputPoints->GetDataType() == VTK_DOUBLE;
+  const bool int32 = !run.vertices.Merged() &&
+    vtkTypeInt32Array::FastDownCast(run.input->GetPolys()->GetConnectivityArray());
   if (doublePoints)
   {
-    ok = int32 ? run(double(), std::int32_t()) : run(double(), vtkIdType());
+    return int32 ? this->RepairSeamsIn<double, std::int32_t>(run)
+                 : this->RepairSeamsIn<double, vtkIdType>(run);
+  }
+  return int32 ? this->RepairSeamsIn<float, std::int32_t>(run)
+               : this->RepairSeamsIn<float, vtkIdType>(run);
+}
+
+//------------------------------------------------------------------------------
+template <typename T, typename I>
+bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
+{
+  Ranks& ranks = run.ranks;
+  const T* positions = nullptr;
+  std::vector<T> copied; // the positions, when the input's cannot be used as they are
+  const I* triangles = nullptr;
+  if (!ranks.Step("copy the input", run.problem,
+        [&]() {
+          triangles = CopyInput<T, I>(run.input, run.vertices, positions, copied, run.connectivity);
+        }))
+  {
+    return false;
+  }
+  PieceRepair<T, I> repair(ranks, run.vertices, run.numbering, run.border, run.keys, positions,
+    triangles, run.input->GetNumberOfPolys());
+  if (!repair.AnalyzeSeams(run.smooth, run.checks, run.problem))
+  {
+    return false;
+  }
+  this->UpdateProgress(0.4);
+  if (run.smooth)
+  {
+    SmoothingSettings settings;
+    settings.Method = this->SmoothingMethod;
+    settings.Iterations = this->NumberOfIterations;
+    settings.Relaxation = this->RelaxationFactor;
+    settings.PassBand = this->PassBand;
+    settings.Window = this->WindowFunction == HAMMING_WINDOW ? rgmc::SincWindow::Hamming
+                                                             : rgmc::SincWindow::Nuttall;
+    auto progress = [this, &ranks](double fraction)
+    {
+      this->UpdateProgress(0.4 + 0.5 * fraction);
+      return ranks.Any(this->CheckAbort());
+    };
+    if (!repair.Smooth(settings, progress, run.problem))
+    {
+      run.aborted = run.problem.empty();
+      return false;
+    }
+    run.normals = repair.Normals(run.problem);
+    if (run.normals.empty() && run.vertices.Count > 0)
+    {
+      return false;
+    }
+  }
+  // The output's points: the input's own when nothing moved and nothing was merged.
+  return ranks.Step("store the output points", run.problem,
+    [&]()
+    {
+      if (!run.smooth && !run.vertices.Merged())
+      {
+        run.points->ShallowCopy(run.input->GetPoints());
+        return;
+      }
+      const std::vector<T>& moved = run.smooth ? repair.Smoothed : copied;
+      vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
+      xyz->SetNumberOfComponents(3);
+      std::copy(moved.begin(), moved.begin() + 3 * run.vertices.Count,
+        rgmc::Allocate(xyz.Get(), 3 * run.vertices.Count));
+      run.points->SetData(xyz);
+    });
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGSeamRepair::StoreSurface(Run& run, vtkPolyData* output)
+{
+  Ranks& ranks = run.ranks;
+  Checks& checks = run.checks;
+  vtkIdType counts[4] = { checks.Edges, checks.Boundary, checks.Border, checks.NonManifold },
+            sums[4] = { 0, 0, 0, 0 };
+  ranks.AllReduce(counts, sums, 4, vtkCommunicator::SUM_OP, "summing the checks");
+  checks.Edges = sums[0];
+  checks.Boundary = sums[1];
+  checks.Border = sums[2];
+  checks.NonManifold = sums[3];
+  output->Initialize();
+  return ranks.Step("build the output", run.problem, [&]() { this->BuildOutput(run, output); });
+}
+
+//------------------------------------------------------------------------------
+// The input's triangles and point data as they are (merged when points were), global ids,
+// duplicate flags, smoothed points and their normals.
+void vtkRGSeamRepair::BuildOutput(Run& run, vtkPolyData* output)
+{
+  vtkPolyData* input = run.input;
+  const LocalVertices& vertices = run.vertices;
+  const vtkIdType n = vertices.Count;
+  output->SetPoints(run.points);
+  vtkPointData* pd = output->GetPointData();
+  pd->CopyGlobalIdsOff();
+  if (run.smooth)
+  {
+    pd->CopyNormalsOff();
+  }
+  if (!vertices.Merged())
+  {
+    output->SetPolys(input->GetPolys());
+    pd->PassData(input->GetPointData());
   }
   else
   {
-    ok = int32 ? run(float(), std::int32_t()) : run(float(), vtkIdType());
+    vtkNew<vtkIdTypeArray> offsets, conn;
+    const vtkIdType numTris = static_cast<vtkIdType>(run.connectivity.size() / 3);
+    vtkIdType* o = rgmc::Allocate(offsets.Get(), numTris + 1);
+    for (vtkIdType t = 0; t <= numTris; ++t)
+    {
+      o[t] = 3 * t;
+    }
+    std::copy(run.connectivity.begin(), run.connectivity.end(),
+      rgmc::Allocate(conn.Get(), static_cast<vtkIdType>(run.connectivity.size())));
+    vtkNew<vtkCellArray> polys;
+    polys->SetData(offsets, conn);
+    output->SetPolys(polys);
+    pd->CopyAllocate(input->GetPointData(), n);
+    for (vtkIdType v = 0; v < n; ++v)
+    {
+      pd->CopyData(input->GetPointData(), vertices.PointOf(v), v);
+    }
   }
-  if (aborted)
+  output->GetCellData()->PassData(input->GetCellData());
+  vtkNew<vtkIdTypeArray> gids;
+  gids->SetName("GlobalPointIds");
+  vtkNew<vtkUnsignedCharArray> ghosts;
+  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  std::copy(run.numbering.Gid.begin(), run.numbering.Gid.end(), rgmc::Allocate(gids.Get(), n));
+  unsigned char* ghost = rgmc::Allocate(ghosts.Get(), n);
+  for (vtkIdType v = 0; v < n; ++v)
   {
-    output->Initialize();
-    return 1;
+    ghost[v] = (run.numbering.Holding[v] & GlobalNumbering::Foreign)
+      ? vtkDataSetAttributes::DUPLICATEPOINT
+      : 0;
   }
-  if (!ok)
+  pd->SetGlobalIds(gids);
+  pd->AddArray(ghosts);
+  if (run.smooth)
   {
-    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
-    output->Initialize();
-    return 0;
+    vtkNew<vtkFloatArray> normalArray;
+    normalArray->SetName("Normals");
+    normalArray->SetNumberOfComponents(3);
+    std::copy(run.normals.begin(), run.normals.end(), rgmc::Allocate(normalArray.Get(), 3 * n));
+    pd->SetNormals(normalArray);
   }
+}
 
-  // Global checks.
-  vtkIdType counts[4] = { checks.Edges, checks.Boundary, checks.Border, checks.NonManifold },
-            sums[4] = { 0, 0, 0, 0 };
-  ranks.Check(ranks.C->AllReduce(counts, sums, 4, vtkCommunicator::SUM_OP), "summing the checks");
-  const vtkIdType euler = numbering.Total - sums[0] + triangles;
-  const bool closed = sums[1] == 0 && sums[3] == 0;
-
-  // PASS 5: the output: the input's triangles and point data as they are (merged when points
-  // were), global ids, duplicate flags, smoothed points and their normals.
-  const vtkIdType n = local.Count;
-  output->Initialize();
-  if (!ranks.Step("build the output", problem,
-        [&]()
-        {
-          output->SetPoints(points);
-          vtkPointData* pd = output->GetPointData();
-          pd->CopyGlobalIdsOff();
-          if (smooth)
-          {
-            pd->CopyNormalsOff();
-          }
-          if (!local.Merged())
-          {
-            output->SetPolys(input->GetPolys());
-            pd->PassData(input->GetPointData());
-          }
-          else
-          {
-            vtkNew<vtkIdTypeArray> offsets, conn;
-            const vtkIdType numTris = static_cast<vtkIdType>(connectivityCopy.size() / 3);
-            vtkIdType* o = rgmc::Allocate(offsets.Get(), numTris + 1);
-            for (vtkIdType t = 0; t <= numTris; ++t)
-            {
-              o[t] = 3 * t;
-            }
-            std::copy(connectivityCopy.begin(), connectivityCopy.end(),
-              rgmc::Allocate(conn.Get(), static_cast<vtkIdType>(connectivityCopy.size())));
-            vtkNew<vtkCellArray> polys;
-            polys->SetData(offsets, conn);
-            output->SetPolys(polys);
-            pd->CopyAllocate(input->GetPointData(), n);
-            for (vtkIdType v = 0; v < n; ++v)
-            {
-              pd->CopyData(input->GetPointData(), local.PointOf(v), v);
-            }
-          }
-          output->GetCellData()->PassData(input->GetCellData());
-          vtkNew<vtkIdTypeArray> gids;
-          gids->SetName("GlobalPointIds");
-          vtkNew<vtkUnsignedCharArray> ghosts;
-          ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-          std::copy(numbering.Gid.begin(), numbering.Gid.end(), rgmc::Allocate(gids.Get(), n));
-          unsigned char* ghost = rgmc::Allocate(ghosts.Get(), n);
-          for (vtkIdType v = 0; v < n; ++v)
-          {
-            ghost[v] = (numbering.Holding[v] & Numbering::Foreign)
-              ? vtkDataSetAttributes::DUPLICATEPOINT
-              : 0;
-          }
-          pd->SetGlobalIds(gids);
-          pd->AddArray(ghosts);
-          if (smooth)
-          {
-            vtkNew<vtkFloatArray> normalArray;
-            normalArray->SetName("Normals");
-            normalArray->SetNumberOfComponents(3);
-            std::copy(normals.begin(), normals.end(), rgmc::Allocate(normalArray.Get(), 3 * n));
-            pd->SetNormals(normalArray);
-          }
-        }))
-  {
-    vtkErrorMacro(<< "Cannot repair the seams: " << problem << ".");
-    output->Initialize();
-    return 0;
-  }
-
+//------------------------------------------------------------------------------
+void vtkRGSeamRepair::ReportChecks(Run& run, vtkPolyData* output)
+{
+  const Checks& sums = run.checks;
+  const vtkIdType unique = run.numbering.Total;
+  const vtkIdType euler = unique - sums.Edges + run.triangles;
+  const bool closed = sums.Boundary == 0 && sums.NonManifold == 0;
   vtkFieldData* fd = output->GetFieldData();
-  fd->PassData(input->GetFieldData());
+  fd->PassData(run.input->GetFieldData());
   auto add = [fd](const char* name, vtkIdType value)
   {
     vtkNew<vtkIdTypeArray> a;
@@ -1602,26 +1871,24 @@ int vtkRGSeamRepair::RequestData(
     a->InsertNextValue(value);
     fd->AddArray(a);
   };
-  add("UniquePoints", numbering.Total);
-  add("Triangles", triangles);
-  add("Edges", sums[0]);
-  add("BoundaryEdges", sums[1]);
-  add("VolumeBorderEdges", sums[2]);
-  add("NonManifoldEdges", sums[3]);
+  add("UniquePoints", unique);
+  add("Triangles", run.triangles);
+  add("Edges", sums.Edges);
+  add("BoundaryEdges", sums.Boundary);
+  add("VolumeBorderEdges", sums.Border);
+  add("NonManifoldEdges", sums.NonManifold);
   add("EulerCharacteristic", euler);
   add("Closed", closed ? 1 : 0);
-  if (ranks.Rank == 0)
+  if (run.ranks.Rank == 0)
   {
     vtkLogF(INFO,
       "Seam repair: %lld unique points, %lld triangles, %lld edges, %lld boundary edges (%lld "
       "more on the volume's border), %lld non-manifold edges, Euler characteristic %lld: %s.",
-      static_cast<long long>(numbering.Total), static_cast<long long>(triangles),
-      static_cast<long long>(sums[0]), static_cast<long long>(sums[1]),
-      static_cast<long long>(sums[2]), static_cast<long long>(sums[3]),
+      static_cast<long long>(unique), static_cast<long long>(run.triangles),
+      static_cast<long long>(sums.Edges), static_cast<long long>(sums.Boundary),
+      static_cast<long long>(sums.Border), static_cast<long long>(sums.NonManifold),
       static_cast<long long>(euler), closed ? "closed" : "not closed");
   }
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 //------------------------------------------------------------------------------
@@ -1636,4 +1903,5 @@ void vtkRGSeamRepair::PrintSelf(ostream& os, vtkIndent indent)
      << "WindowFunction: " << (this->WindowFunction == HAMMING_WINDOW ? "Hamming" : "Nuttall")
      << "\n";
   os << indent << "Controller: " << this->Controller << "\n";
+  os << indent << "NumberOfCollectives: " << this->NumberOfCollectives << "\n";
 }

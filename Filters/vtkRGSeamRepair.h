@@ -128,6 +128,12 @@ public:
   vtkGetObjectMacro(Controller, vtkMultiProcessController);
   ///@}
 
+  /**
+   * The collective calls this rank made in the last execution (agreements, reductions,
+   * gathers; not the messages between pairs of ranks): the same on every rank (tested).
+   */
+  vtkGetMacro(NumberOfCollectives, vtkIdType);
+
 protected:
   vtkRGSeamRepair();
   ~vtkRGSeamRepair() override;
@@ -140,10 +146,24 @@ protected:
   double PassBand = 0.1;
   int WindowFunction = NUTTALL_WINDOW;
   vtkMultiProcessController* Controller = nullptr;
+  vtkIdType NumberOfCollectives = 0;
 
 private:
   vtkRGSeamRepair(const vtkRGSeamRepair&) = delete;
   void operator=(const vtkRGSeamRepair&) = delete;
+
+  // The passes of RequestData, in order (the collective schedule is written above it). Each
+  // returns false on every rank alike, with the problem in the run.
+  struct Run;
+  bool CheckInput(Run& run);
+  bool NumberVertices(Run& run);
+  void FindBorder(Run& run);
+  bool RepairSeams(Run& run);
+  template <typename T, typename I>
+  bool RepairSeamsIn(Run& run);
+  bool StoreSurface(Run& run, vtkPolyData* output);
+  void BuildOutput(Run& run, vtkPolyData* output);
+  void ReportChecks(Run& run, vtkPolyData* output);
 };
 
 #endif

@@ -1,13 +1,13 @@
 """A fingerprint of every output the filters make, to prove a refactoring changed none of them.
 
-Run with pvbatch --symmetric, on any number of ranks; each rank prints one line per output with
-the SHA-256 of its piece (points, cells, every point, cell and field array, in order), rank 0
-also the SHA-256 of each file the Merged Surface Writer wrote:
+Run with pvbatch --symmetric, on any number of ranks; each rank writes DIR/fingerprint.R-of-N.txt,
+one line per output with the SHA-256 of its piece (points, cells, every point, cell and field
+array, in order), rank 0 also the SHA-256 of each file the Merged Surface Writer wrote:
 
   mpiexec -n 3 pvbatch --symmetric Scripts/rgmc_fingerprint.py --plugin PLUGIN --out DIR
+  sort DIR/fingerprint.*-of-3.txt
 
-Compare the printed lines of two builds (sorted) for the same rank count: equal lines, equal
-outputs. Covers the three extraction modes, Seam Repair without smoothing, with Laplacian and
+Compare those lines of two builds for the same rank count: equal lines, equal outputs. Covers the three extraction modes, Seam Repair without smoothing, with Laplacian and
 windowed sinc smoothing, on vertex keys and on exact coordinates (ParaView's Contour), in float
 and double points, and the writer's STL, PLY and VTP.
 """
@@ -100,8 +100,9 @@ def main():
         if rank == 0:
             with open(path, "rb") as f:
                 lines.append("file %s: %s" % (extension, hashlib.sha256(f.read()).hexdigest()))
-    for line in lines:
-        print(line, flush=True)
+    # One file per rank (the ranks' standard outputs interleave), and the lines on stdout.
+    with open(os.path.join(args.out, "fingerprint.%d-of-%d.txt" % (rank, ranks)), "w") as f:
+        f.write("".join(line + "\n" for line in lines))
 
 
 if __name__ == "__main__":

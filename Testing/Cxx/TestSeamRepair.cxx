@@ -118,6 +118,13 @@ Repaired Repair(vtkMultiProcessController* controller, vtkPolyData* input, int m
   r.Output = vtkSmartPointer<vtkPolyData>::New();
   r.Output->ShallowCopy(repair->GetOutput());
   r.Errors = catcher->Errors;
+  // Every rank made the same collective calls (a rank that skipped one would hang or mismatch
+  // in a later run; counted by the filter itself).
+  const vtkIdType collectives = repair->GetNumberOfCollectives();
+  const bool same = SameOnAllRanks(controller, std::to_string(collectives));
+  RGMC_CHECK(same && collectives > 0,
+    "Seam Repair, method " << method << ": the ranks made different numbers of collective calls ("
+                           << collectives << " here)");
   return r;
 }
 
