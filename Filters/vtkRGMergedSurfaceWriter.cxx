@@ -789,188 +789,244 @@ vtkTypeBool vtkRGMergedSurfaceWriter::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------
+/// What one execution carries from pass to pass on this rank.
+struct vtkRGMergedSurfaceWriter::Run
+{
+  explicit Run(vtkMultiProcessController* controller)
+    : ranks(controller)
+  {
+  }
+  rgmc::Ranks ranks;
+  std::string problem;   // the agreed error of a failed pass
+  std::string name;      // the file's
+  std::string extension; // stl, ply, vtp or pvtp
+  vtkNew<vtkPolyData> surface;
+  Mesh mesh;
+  Int vertices = 0, triangles = 0, firstTriangle = 0; // over all ranks; this rank's first
+  bool normals = true;                                // every rank has them
+};
+
+//------------------------------------------------------------------------------
+// The collective schedule: every rank runs these passes in this order and makes the same
+// collective calls in each (an agreement is one collective call on success, one or two
+// broadcasts more on failure); a pass that fails returns on every rank at the same point.
+//
+//  PASS 1 AgreeOnFile     agreement (the name and format)
+//         WritePieces     .pvtp only: vtkXMLPPolyDataWriter (its own collectives), agreement
+//  PASS 2 NumberSurface   per attempt (at most 2): agreement (collected), AllGather (counts),
+//                         agreement, a reduction (ready); before the second, Seam Repair
+//                         without smoothing (its own schedule) and an agreement
+//  PASS 3 WriteMerged     a reduction (double points); agreement (rank 0 created the file),
+//  PASS 4                 agreement (every rank opened it), agreement (every rank wrote)
 void vtkRGMergedSurfaceWriter::WriteData()
 {
   vtkNew<vtkDummyController> single;
-  rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
-  vtkPolyData* input = vtkPolyData::SafeDownCast(this->GetInput());
-  auto fail = [this](const std::string& problem)
-  {
-    vtkErrorMacro(<< "Cannot write the surface: " << problem << ".");
-    this->SetErrorCode(1);
-  };
-
+  Run run(this->Controller ? this->Controller : single.Get());
   // PASS 1: the file name and the format, agreed.
-  std::string problem;
-  const std::string name = this->FileName ? this->FileName : "";
-  const std::size_t dot = name.find_last_of('.');
-  const std::string extension = dot == std::string::npos ? "" : name.substr(dot + 1);
-  if (name.empty())
+  if (!this->AgreeOnFile(run))
   {
-    problem = "no file name is set";
+    this->Fail(run.problem);
+    return;
+  }
+  if (vtkPolyData* input = vtkPolyData::SafeDownCast(this->GetInput()))
+  {
+    run.surface->ShallowCopy(input);
+  }
+  if (run.extension == "pvtp")
+  {
+    if (!this->WritePieces(run))
+    {
+      this->Fail(run.problem);
+    }
+    return;
+  }
+  // PASS 2: the surface numbered as one mesh.
+  if (!this->NumberSurface(run))
+  {
+    this->Fail(run.problem);
+    return;
+  }
+  // PASS 3-4: one file, every rank writing its records.
+  if (!this->WriteMerged(run))
+  {
+    this->Fail(run.problem);
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkRGMergedSurfaceWriter::Fail(const std::string& problem)
+{
+  vtkErrorMacro(<< "Cannot write the surface: " << problem << ".");
+  this->SetErrorCode(1);
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGMergedSurfaceWriter::AgreeOnFile(Run& run)
+{
+  run.name = this->FileName ? this->FileName : "";
+  const std::size_t dot = run.name.find_last_of('.');
+  run.extension = dot == std::string::npos ? "" : run.name.substr(dot + 1);
+  const std::string& extension = run.extension;
+  if (run.name.empty())
+  {
+    run.problem = "no file name is set";
   }
   else if (extension != "stl" && extension != "ply" && extension != "vtp" && extension != "pvtp")
   {
-    problem = "the file name " + name + " must end in .stl, .ply, .vtp or .pvtp";
+    run.problem = "the file name " + run.name + " must end in .stl, .ply, .vtp or .pvtp";
   }
-  if (!ranks.Agree(problem.empty(), problem))
-  {
-    fail(problem);
-    return;
-  }
-  vtkNew<vtkPolyData> surface;
-  if (input)
-  {
-    surface->ShallowCopy(input);
-  }
+  return run.ranks.Agree(run.problem.empty(), run.problem);
+}
 
-  if (extension == "pvtp")
+//------------------------------------------------------------------------------
+// ParaView's parallel form: each rank's piece as it is, and the index on rank 0.
+bool vtkRGMergedSurfaceWriter::WritePieces(Run& run)
+{
+  vtkNew<vtkXMLPPolyDataWriter> pieces;
+  ErrorCatcher catcher(pieces);
+  pieces->SetController(run.ranks.Controller());
+  pieces->SetNumberOfPieces(run.ranks.Size);
+  pieces->SetStartPiece(run.ranks.Rank);
+  pieces->SetEndPiece(run.ranks.Rank);
+  pieces->SetFileName(run.name.c_str());
+  if (this->FileType == VTK_ASCII)
   {
-    // ParaView's parallel form: each rank's piece as it is, and the index on rank 0.
-    vtkNew<vtkXMLPPolyDataWriter> pieces;
-    ErrorCatcher catcher(pieces);
-    pieces->SetController(ranks.Controller());
-    pieces->SetNumberOfPieces(ranks.Size);
-    pieces->SetStartPiece(ranks.Rank);
-    pieces->SetEndPiece(ranks.Rank);
-    pieces->SetFileName(name.c_str());
-    if (this->FileType == VTK_ASCII)
-    {
-      pieces->SetDataModeToAscii();
-    }
-    else
-    {
-      pieces->SetDataModeToBinary(); // inline: appended data does not load on Debian 12
-    }
-    pieces->SetInputData(surface);
-    const bool ok = pieces->Write() != 0 && pieces->GetErrorCode() == 0;
-    problem = catcher.Message.empty() ? "could not write " + name : catcher.Message;
-    if (!ranks.Agree(ok, problem))
-    {
-      fail(problem);
-    }
-    return;
+    pieces->SetDataModeToAscii();
   }
+  else
+  {
+    pieces->SetDataModeToBinary(); // inline: appended data does not load on Debian 12
+  }
+  pieces->SetInputData(run.surface);
+  const bool ok = pieces->Write() != 0 && pieces->GetErrorCode() == 0;
+  run.problem = catcher.Message.empty() ? "could not write " + run.name : catcher.Message;
+  return run.ranks.Agree(ok, run.problem);
+}
 
-  // PASS 2: the surface numbered as one mesh: Seam Repair's numbering when the input has it,
-  // otherwise numbered here (by Seam Repair without smoothing, which also names what is not a
-  // triangle mesh), and the global counts with this rank's first triangle.
-  Mesh mesh;
-  Int vertices = 0, triangles = 0, firstTriangle = 0;
-  bool normals = true;
+//------------------------------------------------------------------------------
+// Seam Repair's numbering when the input has it, otherwise numbered here (by Seam Repair
+// without smoothing, which also names what is not a triangle mesh), and the global counts with
+// this rank's first triangle.
+bool vtkRGMergedSurfaceWriter::NumberSurface(Run& run)
+{
+  rgmc::Ranks& ranks = run.ranks;
   for (int attempt = 0;; ++attempt)
   {
-    const Collected collected = Collect(surface, mesh);
-    problem = "out of memory while collecting this rank's vertices and triangles";
-    if (!ranks.Agree(collected != Collected::OutOfMemory, problem))
+    const Collected collected = Collect(run.surface, run.mesh);
+    run.problem = "out of memory while collecting this rank's vertices and triangles";
+    if (!ranks.Agree(collected != Collected::OutOfMemory, run.problem))
     {
-      fail(problem);
-      return;
+      return false;
     }
-    Int local[3] = { static_cast<Int>(mesh.Owned.size()),
-      static_cast<Int>(mesh.Triangles.size() / 3),
-      surface->GetNumberOfPoints() > 0 && !mesh.Normals ? 1 : 0 };
+    Int local[3] = { static_cast<Int>(run.mesh.Owned.size()),
+      static_cast<Int>(run.mesh.Triangles.size() / 3),
+      run.surface->GetNumberOfPoints() > 0 && !run.mesh.Normals ? 1 : 0 };
     std::vector<Int> all(3 * static_cast<std::size_t>(ranks.Size));
     ranks.AllGather(local, all.data(), 3, "exchanging the counts");
-    if (!ranks.Agree(true, problem))
+    if (!ranks.Agree(true, run.problem))
     {
-      fail(problem);
-      return;
+      return false;
     }
-    vertices = triangles = firstTriangle = 0;
-    normals = true;
+    run.vertices = run.triangles = run.firstTriangle = 0;
+    run.normals = true;
     for (int r = 0; r < ranks.Size; ++r)
     {
       if (r == ranks.Rank)
       {
-        firstTriangle = triangles;
+        run.firstTriangle = run.triangles;
       }
-      vertices += all[3 * r];
-      triangles += all[3 * r + 1];
-      normals = normals && all[3 * r + 2] == 0;
+      run.vertices += all[3 * r];
+      run.triangles += all[3 * r + 1];
+      run.normals = run.normals && all[3 * r + 2] == 0;
     }
-    const bool ready = collected == Collected::Numbered && Placeable(mesh, vertices);
+    const bool ready = collected == Collected::Numbered && Placeable(run.mesh, run.vertices);
     if (!ranks.Any(!ready))
     {
-      break;
+      return true;
     }
     if (attempt > 0)
     {
-      fail("Seam Repair's numbering of the surface is not contiguous");
-      return;
+      run.problem = "Seam Repair's numbering of the surface is not contiguous";
+      return false;
     }
     vtkNew<vtkRGSeamRepair> numbering;
     ErrorCatcher catcher(numbering);
     numbering->SetController(ranks.Controller());
     numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
-    numbering->SetInputData(surface);
+    numbering->SetInputData(run.surface);
     numbering->Update(); // collective; it agrees its errors over the ranks itself
-    problem = "it cannot be numbered as one mesh: " + catcher.Message;
-    if (!ranks.Agree(catcher.Message.empty(), problem))
+    run.problem = "it cannot be numbered as one mesh: " + catcher.Message;
+    if (!ranks.Agree(catcher.Message.empty(), run.problem))
     {
-      fail(problem);
-      return;
+      return false;
     }
     auto numbered = vtkSmartPointer<vtkPolyData>::New();
     numbered->ShallowCopy(numbering->GetOutput());
-    surface->ShallowCopy(numbered);
+    run.surface->ShallowCopy(numbered);
   }
-  normals = normals && extension != "stl" && vertices > 0;
+}
+
+//------------------------------------------------------------------------------
+// Rank 0 creates the file, then every other rank opens it; every rank writes its records,
+// rank 0 also the texts. A file that failed on some rank is incomplete: it is removed.
+bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
+{
+  rgmc::Ranks& ranks = run.ranks;
+  const std::string& extension = run.extension;
+  const bool normals = run.normals && extension != "stl" && run.vertices > 0;
   const Format format =
     extension == "stl" ? Format::STL : (extension == "ply" ? Format::PLY : Format::VTP);
   // The points' type is in the header: double when any rank has double points.
-  const bool doublePoints =
-    ranks.Any(format != Format::STL && mesh.Points && mesh.Points->GetDataType() == VTK_DOUBLE);
-  MergedFile file(format, this->FileType != VTK_ASCII, mesh, vertices, triangles, firstTriangle,
-    normals, doublePoints);
-  problem = file.Limit();
-  if (!problem.empty())
+  const bool doublePoints = ranks.Any(
+    format != Format::STL && run.mesh.Points && run.mesh.Points->GetDataType() == VTK_DOUBLE);
+  MergedFile file(format, this->FileType != VTK_ASCII, run.mesh, run.vertices, run.triangles,
+    run.firstTriangle, normals, doublePoints);
+  run.problem = file.Limit();
+  if (!run.problem.empty())
   {
-    fail(problem); // the same on every rank: the counts are global
-    return;
+    return false; // the same on every rank: the counts are global
   }
   file.Plan();
 
   // PASS 3: rank 0 creates the file, then every other rank opens it.
   RangeFile out;
-  bool ok = ranks.Rank != 0 || out.Open(name, true);
+  bool ok = ranks.Rank != 0 || out.Open(run.name, true);
   if (!ranks.Agree(ok, out.Problem))
   {
-    fail(out.Problem);
-    return;
+    run.problem = out.Problem;
+    return false;
   }
-  ok = ranks.Rank == 0 || out.Open(name, false);
-  problem = out.Problem;
-  if (ranks.Agree(ok, problem))
+  ok = ranks.Rank == 0 || out.Open(run.name, false);
+  run.problem = out.Problem;
+  if (ranks.Agree(ok, run.problem))
   {
     // PASS 4: every rank writes its records; rank 0 also the texts.
     bool written = false;
     try
     {
       written = file.Write(out, ranks.Rank == 0);
-      problem = file.Problem;
+      run.problem = file.Problem;
     }
     catch (const std::bad_alloc&)
     {
-      problem = "out of memory while writing " + name;
+      run.problem = "out of memory while writing " + run.name;
     }
     ok = out.Close() && written;
     if (!out.Problem.empty())
     {
-      problem = out.Problem;
+      run.problem = out.Problem;
     }
-    if (ranks.Agree(ok, problem))
+    if (ranks.Agree(ok, run.problem))
     {
-      return;
+      return true;
     }
   }
-  // A file that failed on some rank is incomplete: remove it.
   out.Close();
   if (ranks.Rank == 0)
   {
-    ::unlink(name.c_str());
+    ::unlink(run.name.c_str());
   }
-  fail(problem);
+  return false;
 }
 
 //------------------------------------------------------------------------------

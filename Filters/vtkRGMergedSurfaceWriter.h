@@ -42,6 +42,8 @@
 #include "RGMCFiltersModule.h" // For export macro
 #include "vtkWriter.h"
 
+#include <string> // For Fail
+
 class vtkMultiProcessController;
 
 class RGMCFILTERS_EXPORT vtkRGMergedSurfaceWriter : public vtkWriter
@@ -80,7 +82,8 @@ protected:
   ~vtkRGMergedSurfaceWriter() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
-  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  vtkTypeBool ProcessRequest(
+    vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   void WriteData() override;
 
   char* FileName = nullptr;
@@ -90,6 +93,15 @@ protected:
 private:
   vtkRGMergedSurfaceWriter(const vtkRGMergedSurfaceWriter&) = delete;
   void operator=(const vtkRGMergedSurfaceWriter&) = delete;
+
+  // The passes of WriteData, in order (the collective schedule is written above it). Each
+  // returns false on every rank alike, with the problem in the run.
+  struct Run;
+  bool AgreeOnFile(Run& run);
+  bool WritePieces(Run& run);
+  bool NumberSurface(Run& run);
+  bool WriteMerged(Run& run);
+  void Fail(const std::string& problem);
 };
 
 #endif
