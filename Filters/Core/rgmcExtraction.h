@@ -476,8 +476,20 @@ private:
   /// then the components' totals.
   void JoinChunks(std::vector<Chunk>& chunks)
   {
+    this->MatchChunkPlanes(chunks);
+    std::vector<std::int64_t> vertexBase, triangleBase;
+    std::int64_t vertices = 0, triangles = 0;
+    this->NumberJoinedVertices(chunks, vertexBase, triangleBase, vertices, triangles);
+    this->CollectChunkPorts(chunks, vertexBase);
+    this->CopyChunks(chunks, vertexBase, triangleBase, vertices, triangles);
+    this->SumComponentTotals();
+  }
+
+  /// Each chunk's vertices on its bottom plane that the chunk below made too (FinalId -1 - the
+  /// chunk below's vertex; 0 for the others), and the components they join.
+  void MatchChunkPlanes(std::vector<Chunk>& chunks)
+  {
     const std::int64_t numChunks = static_cast<std::int64_t>(chunks.size());
-    // Each chunk's vertices on its bottom plane that the chunk below made too.
     this->Volume.Parallel(numChunks,
       [&](std::int64_t c)
       {
@@ -512,10 +524,16 @@ private:
           }
         }
       });
-    // Joins, in chunk order; vertex ids in the joined mesh.
-    std::int64_t vertices = 0, triangles = 0;
-    std::vector<std::int64_t> vertexBase(static_cast<std::size_t>(numChunks)),
-      triangleBase(static_cast<std::size_t>(numChunks));
+  }
+
+  /// Joins the components, in chunk order; numbers the vertices of the joined mesh (a vertex
+  /// the chunk below made gets that one's number) and gives each chunk its first vertex and
+  /// triangle there.
+  void NumberJoinedVertices(std::vector<Chunk>& chunks, std::vector<std::int64_t>& vertexBase,
+    std::vector<std::int64_t>& triangleBase, std::int64_t& vertices, std::int64_t& triangles)
+  {
+    vertexBase.resize(chunks.size());
+    triangleBase.resize(chunks.size());
     for (Chunk& chunk : chunks)
     {
       for (const auto& pair : chunk.Joins)
@@ -550,7 +568,13 @@ private:
         }
       }
     }
-    for (Chunk& chunk : chunks)
+  }
+
+  /// The ports of the joined mesh: each chunk's, on its own vertices.
+  void CollectChunkPorts(
+    const std::vector<Chunk>& chunks, const std::vector<std::int64_t>& vertexBase)
+  {
+    for (const Chunk& chunk : chunks)
     {
       for (const ChunkPort& port : chunk.Ports)
       {
@@ -562,7 +586,14 @@ private:
         }
       }
     }
-    // The joined mesh: each chunk's own vertices and all its triangles, copied in place.
+  }
+
+  /// The joined mesh: each chunk's own vertices and all its triangles, copied in place (the
+  /// chunks are released).
+  void CopyChunks(std::vector<Chunk>& chunks, const std::vector<std::int64_t>& vertexBase,
+    const std::vector<std::int64_t>& triangleBase, std::int64_t vertices, std::int64_t triangles)
+  {
+    const std::int64_t numChunks = static_cast<std::int64_t>(chunks.size());
     LocalMesh& m = this->Mesh;
     const bool doublePoints = this->Volume.Options.DoublePoints;
     const bool normals = this->Volume.Options.ComputeNormals;
@@ -626,7 +657,14 @@ private:
         }
         chunk = Chunk();
       });
-    // The components' totals: triangles and smallest key, on their roots.
+  }
+
+  /// The components' totals: triangles and smallest key, on their roots.
+  void SumComponentTotals()
+  {
+    const LocalMesh& m = this->Mesh;
+    const std::size_t nt = static_cast<std::size_t>(m.NumberOfTriangles());
+    const std::size_t nv = static_cast<std::size_t>(m.NumberOfPoints());
     for (std::size_t t = 0; t < nt; ++t)
     {
       ++this->Components.TotalsOf(this->Components.Root(m.TriangleComponent[t])).Triangles;
