@@ -76,21 +76,28 @@ struct QuietGDCM
   }
 };
 
-/// What the scan keeps of one file.
-struct FileHeader
+/// How the pixels of a file are stored: what the scan checks across a series, and what every
+/// rank needs to decode the files of its slices.
+struct PixelDescription
 {
-  std::string Path, SeriesUID, SeriesDescription, Modality, TransferSyntaxUID, Photometric;
-  int TransferSyntax = gdcm::TransferSyntax::TS_END;
   int Rows = 0, Columns = 0, Samples = 1, Planar = 0, BitsAllocated = 0, BitsStored = 0;
   int PixelRepresentation = 0, Frames = 1;
+  int TransferSyntax = gdcm::TransferSyntax::TS_END;
+  std::string Photometric;
+  bool Encapsulated = false;
+};
+
+/// What the scan keeps of one file.
+struct FileHeader : PixelDescription
+{
+  std::string Path, SeriesUID, SeriesDescription, Modality, TransferSyntaxUID;
   bool HasPosition = false, HasOrientation = false, HasSpacing = false;
   double Position[3] = { 0, 0, 0 }, Orientation[6] = { 1, 0, 0, 0, 1, 0 };
   double PixelSpacing[2] = { 1, 1 };
   double Slope = 1, Intercept = 0;
   std::vector<double> FrameOffsets;
   double SpacingBetweenSlices = 0, SliceThickness = 0;
-  double Projection = 0; // position along the slice normal
-  bool Encapsulated = false;
+  double Projection = 0;        // position along the slice normal
   std::uint64_t PixelBytes = 0; // native pixel data present in the file
 };
 
@@ -219,6 +226,120 @@ enum class Parsed
   Broken    // marked as DICOM but unreadable: an error
 };
 
+/// The pixel description, the series and the transfer syntax of a file whose header GDCM read;
+/// false with `problem` when its NumberOfFrames is impossible.
+bool ReadPixelTags(const gdcm::File& file, FileHeader& h, std::string& problem)
+{
+  const gdcm::DataSet& ds = file.GetDataSet();
+  const gdcm::TransferSyntax& ts = file.GetHeader().GetDataSetTransferSyntax();
+  h.TransferSyntax = ts;
+  h.TransferSyntaxUID = Trim(Text(file.GetHeader(), gdcm::Tag(0x0002, 0x0010)));
+  if (h.TransferSyntaxUID.empty() && ts.IsValid())
+  {
+    h.TransferSyntaxUID = gdcm::TransferSyntax::GetTSString(ts);
+  }
+  h.SeriesUID = Text(ds, SeriesUIDTag);
+  h.SeriesDescription = Text(ds, SeriesDescriptionTag);
+  h.Modality = Text(ds, ModalityTag);
+  UnsignedShort(ds, SamplesTag, h.Samples);
+  UnsignedShort(ds, PlanarTag, h.Planar);
+  h.Photometric = Text(ds, PhotometricTag);
+  UnsignedShort(ds, BitsAllocatedTag, h.BitsAllocated);
+  if (!UnsignedShort(ds, BitsStoredTag, h.BitsStored))
+  {
+    h.BitsStored = h.BitsAllocated;
+  }
+  UnsignedShort(ds, PixelRepresentationTag, h.PixelRepresentation);
+  std::vector<double> v;
+  if (Numbers(Text(ds, FramesTag), v))
+  {
+    if (v[0] < 1 || v[0] > 1e6 || v[0] != std::floor(v[0]))
+    {
+      problem = "has a NumberOfFrames of " + Text(ds, FramesTag);
+      return false;
+    }
+    h.Frames = static_cast<int>(v[0]);
+  }
+  return true;
+}
+
+/// The `count` numbers of `name` (ImagePositionPatient, ImageOrientationPatient) into `values`,
+/// with `present` set, when the file has them; false with `problem` when it has something else.
+bool FixedNumbers(const gdcm::DataSet& ds, const gdcm::Tag& tag, const std::string& name,
+  std::size_t count, double* values, bool& present, std::string& problem)
+{
+  std::vector<double> v;
+  if (Numbers(Text(ds, tag), v))
+  {
+    if (v.size() != count)
+    {
+      problem = "has an " + name + " of " + std::to_string(v.size()) + " numbers, not " +
+        std::to_string(count);
+      return false;
+    }
+    present = true;
+    std::copy(v.begin(), v.end(), values);
+  }
+  else if (!Text(ds, tag).empty())
+  {
+    problem = "has an " + name + " that is not " + std::to_string(count) + " numbers: '" +
+      Text(ds, tag) + "'";
+    return false;
+  }
+  return true;
+}
+
+/// Where the file's slice lies and how its samples scale; false with `problem` when a value is
+/// impossible.
+bool ReadSliceTags(const gdcm::DataSet& ds, FileHeader& h, std::string& problem)
+{
+  if (!FixedNumbers(
+        ds, PositionTag, "ImagePositionPatient", 3, h.Position, h.HasPosition, problem) ||
+    !FixedNumbers(
+      ds, OrientationTag, "ImageOrientationPatient", 6, h.Orientation, h.HasOrientation, problem))
+  {
+    return false;
+  }
+  std::vector<double> v;
+  if (Numbers(Text(ds, PixelSpacingTag), v) || Numbers(Text(ds, ImagerPixelSpacingTag), v))
+  {
+    if (v.size() != 2 || v[0] <= 0 || v[1] <= 0)
+    {
+      problem = "has a PixelSpacing that is not two positive numbers";
+      return false;
+    }
+    h.HasSpacing = true;
+    h.PixelSpacing[0] = v[0];
+    h.PixelSpacing[1] = v[1];
+  }
+  if (Numbers(Text(ds, SlopeTag), v))
+  {
+    h.Slope = v[0];
+    if (h.Slope == 0)
+    {
+      problem = "has a RescaleSlope of 0";
+      return false;
+    }
+  }
+  if (Numbers(Text(ds, InterceptTag), v))
+  {
+    h.Intercept = v[0];
+  }
+  if (Numbers(Text(ds, FrameOffsetsTag), v))
+  {
+    h.FrameOffsets = v;
+  }
+  if (Numbers(Text(ds, SpacingBetweenSlicesTag), v) && v[0] > 0)
+  {
+    h.SpacingBetweenSlices = v[0];
+  }
+  if (Numbers(Text(ds, SliceThicknessTag), v) && v[0] > 0)
+  {
+    h.SliceThickness = v[0];
+  }
+  return true;
+}
+
 /// Reads one file's header (GDCM stops before the pixel data) into `h`.
 Parsed ParseHeader(const std::string& path, FileHeader& h, std::string& problem)
 {
@@ -276,103 +397,8 @@ Parsed ParseHeader(const std::string& path, FileHeader& h, std::string& problem)
   {
     return marked || ds.Size() > 0 ? Parsed::NoImage : Parsed::NotDicom;
   }
-  const gdcm::TransferSyntax& ts = file.GetHeader().GetDataSetTransferSyntax();
-  h.TransferSyntax = ts;
-  h.TransferSyntaxUID = Trim(Text(file.GetHeader(), gdcm::Tag(0x0002, 0x0010)));
-  if (h.TransferSyntaxUID.empty() && ts.IsValid())
-  {
-    h.TransferSyntaxUID = gdcm::TransferSyntax::GetTSString(ts);
-  }
-  h.SeriesUID = Text(ds, SeriesUIDTag);
-  h.SeriesDescription = Text(ds, SeriesDescriptionTag);
-  h.Modality = Text(ds, ModalityTag);
-  UnsignedShort(ds, SamplesTag, h.Samples);
-  UnsignedShort(ds, PlanarTag, h.Planar);
-  h.Photometric = Text(ds, PhotometricTag);
-  UnsignedShort(ds, BitsAllocatedTag, h.BitsAllocated);
-  if (!UnsignedShort(ds, BitsStoredTag, h.BitsStored))
-  {
-    h.BitsStored = h.BitsAllocated;
-  }
-  UnsignedShort(ds, PixelRepresentationTag, h.PixelRepresentation);
-  std::vector<double> v;
-  if (Numbers(Text(ds, FramesTag), v))
-  {
-    if (v[0] < 1 || v[0] > 1e6 || v[0] != std::floor(v[0]))
-    {
-      problem = "has a NumberOfFrames of " + Text(ds, FramesTag);
-      return Parsed::Broken;
-    }
-    h.Frames = static_cast<int>(v[0]);
-  }
-  if (Numbers(Text(ds, PositionTag), v))
-  {
-    if (v.size() != 3)
-    {
-      problem = "has an ImagePositionPatient of " + std::to_string(v.size()) + " numbers, not 3";
-      return Parsed::Broken;
-    }
-    h.HasPosition = true;
-    std::copy(v.begin(), v.end(), h.Position);
-  }
-  else if (!Text(ds, PositionTag).empty())
-  {
-    problem = "has an ImagePositionPatient that is not 3 numbers: '" + Text(ds, PositionTag) + "'";
-    return Parsed::Broken;
-  }
-  if (Numbers(Text(ds, OrientationTag), v))
-  {
-    if (v.size() != 6)
-    {
-      problem = "has an ImageOrientationPatient of " + std::to_string(v.size()) + " numbers, not 6";
-      return Parsed::Broken;
-    }
-    h.HasOrientation = true;
-    std::copy(v.begin(), v.end(), h.Orientation);
-  }
-  else if (!Text(ds, OrientationTag).empty())
-  {
-    problem =
-      "has an ImageOrientationPatient that is not 6 numbers: '" + Text(ds, OrientationTag) + "'";
-    return Parsed::Broken;
-  }
-  if (Numbers(Text(ds, PixelSpacingTag), v) || Numbers(Text(ds, ImagerPixelSpacingTag), v))
-  {
-    if (v.size() != 2 || v[0] <= 0 || v[1] <= 0)
-    {
-      problem = "has a PixelSpacing that is not two positive numbers";
-      return Parsed::Broken;
-    }
-    h.HasSpacing = true;
-    h.PixelSpacing[0] = v[0];
-    h.PixelSpacing[1] = v[1];
-  }
-  if (Numbers(Text(ds, SlopeTag), v))
-  {
-    h.Slope = v[0];
-    if (h.Slope == 0)
-    {
-      problem = "has a RescaleSlope of 0";
-      return Parsed::Broken;
-    }
-  }
-  if (Numbers(Text(ds, InterceptTag), v))
-  {
-    h.Intercept = v[0];
-  }
-  if (Numbers(Text(ds, FrameOffsetsTag), v))
-  {
-    h.FrameOffsets = v;
-  }
-  if (Numbers(Text(ds, SpacingBetweenSlicesTag), v) && v[0] > 0)
-  {
-    h.SpacingBetweenSlices = v[0];
-  }
-  if (Numbers(Text(ds, SliceThicknessTag), v) && v[0] > 0)
-  {
-    h.SliceThickness = v[0];
-  }
-  return Parsed::Image;
+  return ReadPixelTags(file, h, problem) && ReadSliceTags(ds, h, problem) ? Parsed::Image
+                                                                          : Parsed::Broken;
 }
 
 /// Checks of what one volume needs from a file's pixel description.
@@ -463,10 +489,7 @@ struct vtkRGDICOMSeriesReader::Internals
   QuietGDCM Quiet;
   // From the header, the same on every rank.
   std::vector<Slice> Slices;
-  int Rows = 0, Columns = 0, Samples = 1, Planar = 0, BitsAllocated = 0, BitsStored = 0;
-  int PixelRepresentation = 0, TransferSyntax = 0, Frames = 1;
-  bool Encapsulated = false;
-  std::string Photometric;
+  PixelDescription Pixels;
   std::size_t Files = 0;
 };
 
@@ -522,23 +545,51 @@ int vtkRGDICOMSeriesReader::CanReadFile(const char* name)
   return fs::is_regular_file(name, error) && ParseHeader(name, h, problem) == Parsed::Image ? 1 : 0;
 }
 
-//------------------------------------------------------------------------------
-bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
+namespace
+{
+
+/// What the header scan has found so far, pass by pass.
+struct SeriesScan
+{
+  // What to read.
+  std::string Name; // FileName: a directory, or one file of the series
+  bool IsDirectory = false;
+  std::string Directory; // the directory whose files are scanned
+  std::string ChosenUID; // the series to read: SeriesInstanceUID, else found by passes 1 and 2
+  // PASS 1
+  std::vector<FileHeader> Images; // every DICOM image of the directory, in name order
+  // PASS 2 and 3: the files of the volume, the chosen series' largest stack (sorted along the
+  // slice normal by pass 5)
+  std::vector<FileHeader> Files;
+  std::string SeriesList; // one line per series, the chosen one first
+  std::string LeftOut;    // the files of the series' other stacks, for messages
+  // PASS 5
+  double Normal[3] = { 0, 0, 1 };
+  double Direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 }; // row-major; columns: row direction,
+                                                       // column direction, slice normal
+  double Origin[3] = { 0, 0, 0 };
+  double SliceSpacing = 1.0; // the mean distance between slices along the normal
+  double Deviation = 0.0;    // the largest deviation of a slice gap from SliceSpacing
+  std::vector<Slice> Slices;
+  int Dimensions[3] = { 0, 0, 0 };
+  double Spacing[3] = { 1, 1, 1 };
+  std::ostringstream Warnings; // one per line, in the order the passes find them
+};
+
+/// PASS 1, first step: the regular files of the directory (FileName's, when it is a file), in
+/// name order (a stable order for the messages).
+bool ListFiles(SeriesScan& scan, std::vector<std::string>& paths, std::string& message)
 {
   std::error_code error;
-  const std::string name = this->FileName;
-  if (!fs::exists(name, error))
+  if (!fs::exists(scan.Name, error))
   {
     message = "no such file or directory";
     return false;
   }
-  const bool isDirectory = fs::is_directory(name, error);
-  const std::string directory = isDirectory ? name : fs::path(name).parent_path().string();
-
-  // PASS 1: every file's header, in name order (a stable order for the messages).
-  std::vector<std::string> paths;
+  scan.IsDirectory = fs::is_directory(scan.Name, error);
+  scan.Directory = scan.IsDirectory ? scan.Name : fs::path(scan.Name).parent_path().string();
   for (const auto& entry :
-    fs::directory_iterator(directory.empty() ? std::string(".") : directory, error))
+    fs::directory_iterator(scan.Directory.empty() ? std::string(".") : scan.Directory, error))
   {
     if (entry.is_regular_file(error))
     {
@@ -547,17 +598,33 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   }
   if (error)
   {
-    message = "cannot list the directory " + directory + ": " + error.message();
+    message = "cannot list the directory " + scan.Directory + ": " + error.message();
     return false;
   }
   std::sort(paths.begin(), paths.end());
   if (paths.empty())
   {
-    message = "the directory " + directory + " is empty: no DICOM series";
+    message = "the directory " + scan.Directory + " is empty: no DICOM series";
     return false;
   }
-  std::vector<FileHeader> images;
-  std::string chosenUID = this->SeriesInstanceUID ? this->SeriesInstanceUID : "";
+  return true;
+}
+
+/// The key a file's series is known by: its SeriesInstanceUID, "(none)" without one.
+std::string SeriesKey(const FileHeader& h)
+{
+  return h.SeriesUID.empty() ? std::string("(none)") : h.SeriesUID;
+}
+
+/// PASS 1: every file's header; FileName's series, when it is a file and no series is named.
+bool ReadHeaders(SeriesScan& scan, std::string& message)
+{
+  std::vector<std::string> paths;
+  if (!ListFiles(scan, paths, message))
+  {
+    return false;
+  }
+  std::error_code error;
   std::size_t skipped = 0;
   for (const std::string& path : paths)
   {
@@ -566,10 +633,10 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
     switch (ParseHeader(path, h, problem))
     {
       case Parsed::Image:
-        images.push_back(h);
-        if (!isDirectory && chosenUID.empty() && fs::equivalent(path, name, error))
+        scan.Images.push_back(h);
+        if (!scan.IsDirectory && scan.ChosenUID.empty() && fs::equivalent(path, scan.Name, error))
         {
-          chosenUID = h.SeriesUID.empty() ? std::string("(none)") : h.SeriesUID;
+          scan.ChosenUID = SeriesKey(h);
         }
         break;
       case Parsed::Broken:
@@ -579,37 +646,25 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
         ++skipped;
     }
   }
-  if (!isDirectory && chosenUID.empty())
+  if (!scan.IsDirectory && scan.ChosenUID.empty())
   {
-    message = name + " holds no DICOM image (no pixel data, or not DICOM)";
+    message = scan.Name + " holds no DICOM image (no pixel data, or not DICOM)";
     return false;
   }
-  if (images.empty())
+  if (scan.Images.empty())
   {
-    message = "no DICOM image in the directory " + directory + " (" + std::to_string(skipped) +
+    message = "no DICOM image in the directory " + scan.Directory + " (" + std::to_string(skipped) +
       " files, none DICOM with pixel data): no DICOM series";
     return false;
   }
+  return true;
+}
 
-  // PASS 2: series by SeriesInstanceUID; the chosen one, else the largest (ties: smallest UID).
-  std::map<std::string, std::vector<FileHeader>> series;
-  for (const FileHeader& h : images)
-  {
-    series[h.SeriesUID.empty() ? std::string("(none)") : h.SeriesUID].push_back(h);
-  }
-  if (chosenUID.empty())
-  {
-    std::size_t most = 0;
-    for (const auto& s : series)
-    {
-      if (s.second.size() > most)
-      {
-        most = s.second.size();
-        chosenUID = s.first;
-      }
-    }
-  }
-  auto found = series.find(chosenUID);
+using SeriesMap = std::map<std::string, std::vector<FileHeader>>;
+
+/// One line per series ("UID: N files, description"), the chosen one first.
+std::string ListSeries(const SeriesMap& series, const std::string& chosenUID)
+{
   std::ostringstream list;
   auto describe = [&](const std::string& uid, const std::vector<FileHeader>& files)
   {
@@ -620,6 +675,7 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
     }
     list << "\n";
   };
+  const auto found = series.find(chosenUID);
   if (found != series.end())
   {
     describe(found->first, found->second);
@@ -631,111 +687,208 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
       describe(s.first, s.second);
     }
   }
-  if (found == series.end())
+  return list.str();
+}
+
+/// PASS 2: series by SeriesInstanceUID; the chosen one, else the largest (ties: smallest UID).
+bool ChooseSeries(SeriesScan& scan, std::string& message)
+{
+  SeriesMap series;
+  for (const FileHeader& h : scan.Images)
   {
-    std::string held = list.str();
-    held.pop_back();
-    std::replace(held.begin(), held.end(), '\n', ';');
-    message = "no series " + chosenUID + " in " + directory + "; it holds: " + held;
-    return false;
+    series[SeriesKey(h)].push_back(h);
   }
-  std::vector<FileHeader>& files = found->second;
-  std::ostringstream warnings;
-  if (series.size() > 1)
+  if (scan.ChosenUID.empty())
   {
-    warnings << directory << " holds " << series.size() << " series; reading " << chosenUID << " ("
-             << files.size() << " files); the others:";
+    std::size_t most = 0;
     for (const auto& s : series)
     {
-      if (s.first != chosenUID)
+      if (s.second.size() > most)
       {
-        warnings << " " << s.first << " (" << s.second.size() << " files)";
+        most = s.second.size();
+        scan.ChosenUID = s.first;
       }
     }
-    warnings << "\n";
   }
-
-  // PASS 3a: one series may hold several stacks (localizers, other acquisitions under the same
-  // SeriesInstanceUID): images of one size, pixel format, orientation and pixel spacing form a
-  // stack; the largest is read (the first found on a tie) and the others are named.
-  std::string leftOut;
+  scan.SeriesList = ListSeries(series, scan.ChosenUID);
+  const auto found = series.find(scan.ChosenUID);
+  if (found == series.end())
   {
-    auto sameStack = [](const FileHeader& a, const FileHeader& b)
+    std::string held = scan.SeriesList;
+    held.pop_back();
+    std::replace(held.begin(), held.end(), '\n', ';');
+    message = "no series " + scan.ChosenUID + " in " + scan.Directory + "; it holds: " + held;
+    return false;
+  }
+  if (series.size() > 1)
+  {
+    scan.Warnings << scan.Directory << " holds " << series.size() << " series; reading "
+                  << scan.ChosenUID << " (" << found->second.size() << " files); the others:";
+    for (const auto& s : series)
     {
-      if (a.Rows != b.Rows || a.Columns != b.Columns || a.Samples != b.Samples ||
-        a.BitsAllocated != b.BitsAllocated || a.BitsStored != b.BitsStored ||
-        a.PixelRepresentation != b.PixelRepresentation || a.HasOrientation != b.HasOrientation ||
-        a.HasSpacing != b.HasSpacing)
+      if (s.first != scan.ChosenUID)
       {
-        return false;
+        scan.Warnings << " " << s.first << " (" << s.second.size() << " files)";
       }
-      for (int c = 0; c < 6; ++c)
-      {
-        if (std::fabs(a.Orientation[c] - b.Orientation[c]) > 1e-4)
-        {
-          return false;
-        }
-      }
-      return std::fabs(a.PixelSpacing[0] - b.PixelSpacing[0]) <= 1e-4 * b.PixelSpacing[0] &&
-        std::fabs(a.PixelSpacing[1] - b.PixelSpacing[1]) <= 1e-4 * b.PixelSpacing[1];
-    };
-    std::vector<std::vector<FileHeader>> stacks;
-    for (FileHeader& h : files)
-    {
-      auto stack = std::find_if(stacks.begin(), stacks.end(),
-        [&](const std::vector<FileHeader>& st) { return sameStack(h, st.front()); });
-      if (stack == stacks.end())
-      {
-        stacks.emplace_back();
-        stack = stacks.end() - 1;
-      }
-      stack->push_back(h);
     }
-    if (stacks.size() > 1)
+    scan.Warnings << "\n";
+  }
+  scan.Files = std::move(found->second);
+  return true;
+}
+
+/// Whether two ImageOrientationPatient agree (each direction cosine to 1e-4).
+bool SameOrientation(const double a[6], const double b[6])
+{
+  for (int c = 0; c < 6; ++c)
+  {
+    if (std::fabs(a[c] - b[c]) > 1e-4)
     {
-      std::size_t largest = 0;
-      for (std::size_t st = 1; st < stacks.size(); ++st)
-      {
-        largest = stacks[st].size() > stacks[largest].size() ? st : largest;
-      }
-      const FileHeader& kept = stacks[largest].front();
-      warnings << "series " << chosenUID << " in " << directory << " mixes " << stacks.size()
-               << " stacks of images (localizers or other acquisitions): reading the largest, "
-               << stacks[largest].size() << " files of " << kept.Columns << " x " << kept.Rows
-               << " pixels; left out:";
-      std::ostringstream names;
-      for (std::size_t st = 0; st < stacks.size(); ++st)
-      {
-        if (st == largest)
-        {
-          continue;
-        }
-        const FileHeader& h = stacks[st].front();
-        warnings << " " << stacks[st].size() << " file" << (stacks[st].size() > 1 ? "s" : "")
-                 << " of " << h.Columns << " x " << h.Rows << " pixels, orientation ("
-                 << Describe(h.Orientation[0]);
-        for (int c = 1; c < 6; ++c)
-        {
-          warnings << ", " << Describe(h.Orientation[c]);
-        }
-        warnings << "), pixel spacing " << Describe(h.PixelSpacing[0]) << " x "
-                 << Describe(h.PixelSpacing[1]) << " mm (";
-        for (std::size_t f = 0; f < stacks[st].size(); ++f)
-        {
-          warnings << (f ? ", " : "") << BaseName(stacks[st][f].Path);
-          names << (names.str().empty() ? "" : ", ") << BaseName(stacks[st][f].Path);
-        }
-        warnings << ");";
-      }
-      warnings << "\n";
-      leftOut = names.str();
-      std::vector<FileHeader> chosen = std::move(stacks[largest]);
-      files.swap(chosen);
+      return false;
     }
   }
+  return true;
+}
 
-  // PASS 3: one volume's worth of consistency, each mismatch naming its file.
-  const FileHeader& first = files.front();
+/// Whether the pixel spacing of `a` agrees with that of `b` (to 1e-4 of b's).
+bool SamePixelSpacing(const FileHeader& a, const FileHeader& b)
+{
+  return std::fabs(a.PixelSpacing[0] - b.PixelSpacing[0]) <= 1e-4 * b.PixelSpacing[0] &&
+    std::fabs(a.PixelSpacing[1] - b.PixelSpacing[1]) <= 1e-4 * b.PixelSpacing[1];
+}
+
+/// "1, 0, 0, 0, 1, 0": the six direction cosines of an ImageOrientationPatient, for messages.
+std::string DescribeOrientation(const double orientation[6])
+{
+  std::string text = Describe(orientation[0]);
+  for (int c = 1; c < 6; ++c)
+  {
+    text += ", " + Describe(orientation[c]);
+  }
+  return text;
+}
+
+/// Whether two images belong to one stack: one size, pixel format, orientation, pixel spacing.
+bool SameStack(const FileHeader& a, const FileHeader& b)
+{
+  return a.Rows == b.Rows && a.Columns == b.Columns && a.Samples == b.Samples &&
+    a.BitsAllocated == b.BitsAllocated && a.BitsStored == b.BitsStored &&
+    a.PixelRepresentation == b.PixelRepresentation && a.HasOrientation == b.HasOrientation &&
+    a.HasSpacing == b.HasSpacing && SameOrientation(a.Orientation, b.Orientation) &&
+    SamePixelSpacing(a, b);
+}
+
+/// Warns that the series mixes stacks and names the files of those left out (kept in
+/// scan.LeftOut for the messages of pass 5).
+void WarnOfOtherStacks(
+  SeriesScan& scan, const std::vector<std::vector<FileHeader>>& stacks, std::size_t largest)
+{
+  std::ostringstream& warnings = scan.Warnings;
+  const FileHeader& kept = stacks[largest].front();
+  warnings << "series " << scan.ChosenUID << " in " << scan.Directory << " mixes " << stacks.size()
+           << " stacks of images (localizers or other acquisitions): reading the largest, "
+           << stacks[largest].size() << " files of " << kept.Columns << " x " << kept.Rows
+           << " pixels; left out:";
+  std::ostringstream names;
+  for (std::size_t st = 0; st < stacks.size(); ++st)
+  {
+    if (st == largest)
+    {
+      continue;
+    }
+    const FileHeader& h = stacks[st].front();
+    warnings << " " << stacks[st].size() << " file" << (stacks[st].size() > 1 ? "s" : "") << " of "
+             << h.Columns << " x " << h.Rows << " pixels, orientation ("
+             << DescribeOrientation(h.Orientation) << "), pixel spacing "
+             << Describe(h.PixelSpacing[0]) << " x " << Describe(h.PixelSpacing[1]) << " mm (";
+    for (std::size_t f = 0; f < stacks[st].size(); ++f)
+    {
+      warnings << (f ? ", " : "") << BaseName(stacks[st][f].Path);
+      names << (names.str().empty() ? "" : ", ") << BaseName(stacks[st][f].Path);
+    }
+    warnings << ");";
+  }
+  warnings << "\n";
+  scan.LeftOut = names.str();
+}
+
+/// PASS 3: one series may hold several stacks (localizers, other acquisitions under the same
+/// SeriesInstanceUID): images of one size, pixel format, orientation and pixel spacing form a
+/// stack; the largest is read (the first found on a tie) and the others are named.
+void ChooseStack(SeriesScan& scan)
+{
+  std::vector<std::vector<FileHeader>> stacks;
+  for (const FileHeader& h : scan.Files)
+  {
+    auto stack = std::find_if(stacks.begin(), stacks.end(),
+      [&](const std::vector<FileHeader>& st) { return SameStack(h, st.front()); });
+    if (stack == stacks.end())
+    {
+      stacks.emplace_back();
+      stack = stacks.end() - 1;
+    }
+    stack->push_back(h);
+  }
+  if (stacks.size() > 1)
+  {
+    std::size_t largest = 0;
+    for (std::size_t st = 1; st < stacks.size(); ++st)
+    {
+      largest = stacks[st].size() > stacks[largest].size() ? st : largest;
+    }
+    WarnOfOtherStacks(scan, stacks, largest);
+    scan.Files = std::move(stacks[largest]);
+  }
+}
+
+/// Why `h` cannot be a slice of one volume with `first`, in a series of `count` files; empty
+/// when it can.
+std::string Mismatch(const FileHeader& h, const FileHeader& first, std::size_t count)
+{
+  std::ostringstream why;
+  if (h.Rows != first.Rows || h.Columns != first.Columns)
+  {
+    why << "is " << h.Columns << " x " << h.Rows << " pixels, while " << BaseName(first.Path)
+        << " is " << first.Columns << " x " << first.Rows << ": mixed image sizes in one series";
+  }
+  else if (h.Samples != first.Samples || h.BitsAllocated != first.BitsAllocated ||
+    h.BitsStored != first.BitsStored || h.PixelRepresentation != first.PixelRepresentation)
+  {
+    why << "has another pixel format than " << BaseName(first.Path) << " (" << h.Samples
+        << " samples of " << h.BitsStored << "/" << h.BitsAllocated << " bits, "
+        << (h.PixelRepresentation ? "signed" : "unsigned") << ", against " << first.Samples
+        << " of " << first.BitsStored << "/" << first.BitsAllocated << ", "
+        << (first.PixelRepresentation ? "signed" : "unsigned") << ")";
+  }
+  else if (h.HasOrientation != first.HasOrientation ||
+    !SameOrientation(h.Orientation, first.Orientation))
+  {
+    why << "has the orientation (" << DescribeOrientation(h.Orientation) << ") while "
+        << BaseName(first.Path) << " has (" << DescribeOrientation(first.Orientation)
+        << "): inconsistent orientation in one series";
+  }
+  else if (h.HasSpacing != first.HasSpacing || !SamePixelSpacing(h, first))
+  {
+    why << "has the pixel spacing " << Describe(h.PixelSpacing[0]) << " x "
+        << Describe(h.PixelSpacing[1]) << " mm while " << BaseName(first.Path) << " has "
+        << Describe(first.PixelSpacing[0]) << " x " << Describe(first.PixelSpacing[1])
+        << " mm: inconsistent pixel spacing in one series";
+  }
+  else if (count > 1 && !h.HasPosition)
+  {
+    why << "has no ImagePositionPatient: its slice cannot be placed in a series of " << count
+        << " files";
+  }
+  else if (count > 1 && h.Frames > 1)
+  {
+    why << "has " << h.Frames << " frames: a series of several multi-frame files is not read";
+  }
+  return why.str();
+}
+
+/// PASS 4: one volume's worth of consistency, each mismatch naming its file.
+bool CheckSeries(const std::vector<FileHeader>& files, std::string& message)
+{
   std::string problem;
   for (const FileHeader& h : files)
   {
@@ -755,293 +908,367 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   }
   for (const FileHeader& h : files)
   {
-    std::ostringstream why;
-    if (h.Rows != first.Rows || h.Columns != first.Columns)
+    const std::string why = Mismatch(h, files.front(), files.size());
+    if (!why.empty())
     {
-      why << "is " << h.Columns << " x " << h.Rows << " pixels, while " << BaseName(first.Path)
-          << " is " << first.Columns << " x " << first.Rows << ": mixed image sizes in one series";
-    }
-    else if (h.Samples != first.Samples || h.BitsAllocated != first.BitsAllocated ||
-      h.BitsStored != first.BitsStored || h.PixelRepresentation != first.PixelRepresentation)
-    {
-      why << "has another pixel format than " << BaseName(first.Path) << " (" << h.Samples
-          << " samples of " << h.BitsStored << "/" << h.BitsAllocated << " bits, "
-          << (h.PixelRepresentation ? "signed" : "unsigned") << ", against " << first.Samples
-          << " of " << first.BitsStored << "/" << first.BitsAllocated << ", "
-          << (first.PixelRepresentation ? "signed" : "unsigned") << ")";
-    }
-    else if (h.HasOrientation != first.HasOrientation ||
-      [&]()
-      {
-        for (int c = 0; c < 6; ++c)
-        {
-          if (std::fabs(h.Orientation[c] - first.Orientation[c]) > 1e-4)
-          {
-            return true;
-          }
-        }
-        return false;
-      }())
-    {
-      why << "has the orientation (" << Describe(h.Orientation[0]);
-      for (int c = 1; c < 6; ++c)
-      {
-        why << ", " << Describe(h.Orientation[c]);
-      }
-      why << ") while " << BaseName(first.Path) << " has (" << Describe(first.Orientation[0]);
-      for (int c = 1; c < 6; ++c)
-      {
-        why << ", " << Describe(first.Orientation[c]);
-      }
-      why << "): inconsistent orientation in one series";
-    }
-    else if (h.HasSpacing != first.HasSpacing ||
-      std::fabs(h.PixelSpacing[0] - first.PixelSpacing[0]) > 1e-4 * first.PixelSpacing[0] ||
-      std::fabs(h.PixelSpacing[1] - first.PixelSpacing[1]) > 1e-4 * first.PixelSpacing[1])
-    {
-      why << "has the pixel spacing " << Describe(h.PixelSpacing[0]) << " x "
-          << Describe(h.PixelSpacing[1]) << " mm while " << BaseName(first.Path) << " has "
-          << Describe(first.PixelSpacing[0]) << " x " << Describe(first.PixelSpacing[1])
-          << " mm: inconsistent pixel spacing in one series";
-    }
-    else if (files.size() > 1 && !h.HasPosition)
-    {
-      why << "has no ImagePositionPatient: its slice cannot be placed in a series of "
-          << files.size() << " files";
-    }
-    else if (files.size() > 1 && h.Frames > 1)
-    {
-      why << "has " << h.Frames << " frames: a series of several multi-frame files is not read";
-    }
-    if (!why.str().empty())
-    {
-      message = h.Path + " " + why.str();
+      message = h.Path + " " + why;
       return false;
     }
   }
+  return true;
+}
 
-  // PASS 4: geometry. Columns of the direction matrix: row direction (along a row, increasing
-  // column index: x), column direction (y), their cross product (the slice normal: z).
+/// PASS 5, first step: the axes from the (unsorted) first file's orientation. Columns of the
+/// direction matrix: row direction (along a row, increasing column index: x), column direction
+/// (y), their cross product (the slice normal: z).
+bool FindAxes(SeriesScan& scan, std::string& message)
+{
+  const FileHeader& first = scan.Files.front();
   double row[3] = { first.Orientation[0], first.Orientation[1], first.Orientation[2] };
-  double col[3] = { first.Orientation[3], first.Orientation[4], first.Orientation[5] };
-  if (vtkMath::Normalize(row) < 1e-6 || vtkMath::Normalize(col) < 1e-6 ||
-    std::fabs(vtkMath::Dot(row, col)) > 1e-3)
+  double column[3] = { first.Orientation[3], first.Orientation[4], first.Orientation[5] };
+  if (vtkMath::Normalize(row) < 1e-6 || vtkMath::Normalize(column) < 1e-6 ||
+    std::fabs(vtkMath::Dot(row, column)) > 1e-3)
   {
     message = first.Path + " has an ImageOrientationPatient whose two directions are not " +
       "orthogonal unit vectors";
     return false;
   }
-  double normal[3];
-  vtkMath::Cross(row, col, normal);
-  vtkMath::Normalize(normal);
-  std::vector<Slice> slices;
-  double sliceSpacing = 1.0, deviation = 0.0;
-  double origin[3] = { first.Position[0], first.Position[1], first.Position[2] };
-  if (files.size() == 1)
+  vtkMath::Cross(row, column, scan.Normal);
+  vtkMath::Normalize(scan.Normal);
+  for (int a = 0; a < 3; ++a)
   {
-    for (int f = 0; f < first.Frames; ++f)
-    {
-      slices.push_back(Slice{ first.Path, f, first.Slope, first.Intercept });
-    }
-    if (first.Frames > 1)
-    {
-      // A multi-frame volume: RT dose places its frames with GridFrameOffsetVector.
-      if (first.FrameOffsets.size() == static_cast<std::size_t>(first.Frames))
-      {
-        const std::vector<double>& o = first.FrameOffsets;
-        sliceSpacing = (o.back() - o.front()) / (first.Frames - 1);
-        for (int f = 1; f < first.Frames; ++f)
-        {
-          deviation = std::max(deviation, std::fabs(o[f] - o[f - 1] - sliceSpacing));
-        }
-        for (int a = 0; a < 3; ++a)
-        {
-          origin[a] += o.front() * normal[a];
-        }
-        if (sliceSpacing < 0)
-        {
-          message = first.Path + " has a decreasing GridFrameOffsetVector";
-          return false;
-        }
-      }
-      else if (first.SpacingBetweenSlices > 0)
-      {
-        sliceSpacing = first.SpacingBetweenSlices;
-      }
-      else if (first.SliceThickness > 0)
-      {
-        sliceSpacing = first.SliceThickness;
-        warnings << first.Path << " has " << first.Frames << " frames without "
-                 << "SpacingBetweenSlices: spaced by their SliceThickness, "
-                 << Describe(sliceSpacing) << " mm\n";
-      }
-      else
-      {
-        warnings << first.Path << " has " << first.Frames << " frames and no slice spacing: "
-                 << "spaced by 1 mm\n";
-      }
-      if (sliceSpacing == 0)
-      {
-        message = first.Path + " has frames at one position (a zero frame spacing)";
-        return false;
-      }
-    }
+    scan.Direction[3 * a] = row[a];
+    scan.Direction[3 * a + 1] = column[a];
+    scan.Direction[3 * a + 2] = scan.Normal[a];
   }
-  else
+  return true;
+}
+
+/// PASS 5 for a series of one file: a slice per frame, at the file's position. A multi-frame
+/// volume is spaced by its GridFrameOffsetVector (RT dose), else SpacingBetweenSlices, else
+/// SliceThickness (a warning), else 1 mm (a warning).
+bool PlaceFrames(SeriesScan& scan, std::string& message)
+{
+  const FileHeader& first = scan.Files.front();
+  std::copy(first.Position, first.Position + 3, scan.Origin);
+  for (int f = 0; f < first.Frames; ++f)
   {
-    for (FileHeader& h : files)
+    scan.Slices.push_back(Slice{ first.Path, f, first.Slope, first.Intercept });
+  }
+  if (first.Frames <= 1)
+  {
+    return true;
+  }
+  if (first.FrameOffsets.size() == static_cast<std::size_t>(first.Frames))
+  {
+    const std::vector<double>& offsets = first.FrameOffsets;
+    scan.SliceSpacing = (offsets.back() - offsets.front()) / (first.Frames - 1);
+    for (int f = 1; f < first.Frames; ++f)
     {
-      h.Projection = vtkMath::Dot(h.Position, normal);
-    }
-    std::stable_sort(files.begin(), files.end(),
-      [](const FileHeader& a, const FileHeader& b) { return a.Projection < b.Projection; });
-    const double extentAlong = files.back().Projection - files.front().Projection;
-    const double tolerance = std::max(1e-4, 1e-6 * std::fabs(extentAlong));
-    for (std::size_t s = 1; s < files.size(); ++s)
-    {
-      if (files[s].Projection - files[s - 1].Projection <= tolerance)
-      {
-        message = files[s].Path + " and " + files[s - 1].Path + " are at the same position (" +
-          Describe(files[s].Projection) + " mm along the slice normal): duplicated slice " +
-          "positions (two acquisitions in one series?)";
-        return false;
-      }
-    }
-    sliceSpacing = extentAlong / (files.size() - 1);
-    std::size_t worst = 1;
-    double smallest = extentAlong, largest = 0.0;
-    for (std::size_t s = 1; s < files.size(); ++s)
-    {
-      const double gap = files[s].Projection - files[s - 1].Projection;
-      smallest = std::min(smallest, gap);
-      largest = std::max(largest, gap);
-      if (std::fabs(gap - sliceSpacing) > deviation)
-      {
-        deviation = std::fabs(gap - sliceSpacing);
-        worst = s;
-      }
-    }
-    // Slices are never stacked as if evenly spaced when they are not (a missing slice, a
-    // variable spacing): under 1% of the mean gap, a warning with the spread; beyond, an error
-    // that names the gap.
-    if (deviation >= 0.01 * sliceSpacing)
-    {
-      message = "the slices of " + directory + " are not evenly spaced: " + files[worst - 1].Path +
-        " and " + files[worst].Path + " are " +
-        Describe(files[worst].Projection - files[worst - 1].Projection) +
-        " mm apart along the slice normal (at " + Describe(files[worst - 1].Projection) + " and " +
-        Describe(files[worst].Projection) + " mm), the mean gap is " + Describe(sliceSpacing) +
-        " mm (a missing slice, or a variable spacing); gaps range from " + Describe(smallest) +
-        " to " + Describe(largest) + " mm" +
-        (leftOut.empty() ? std::string()
-                         : "; left out of this stack as another acquisition: " + leftOut);
-      return false;
-    }
-    if (deviation > std::max(1e-3 * sliceSpacing, 1e-4))
-    {
-      warnings << "irregular slice spacing in " << directory << ": the gaps between slices "
-               << "range from " << Describe(smallest) << " to " << Describe(largest) << " mm (mean "
-               << Describe(sliceSpacing) << " mm; largest deviation " << Describe(deviation)
-               << " mm, at " << BaseName(files[worst].Path)
-               << ", under 1%); the volume is read with the mean spacing\n";
-    }
-    // Positions off the normal through the first slice cannot be represented: a stack sheared
-    // along its planes is a CT acquired with the gantry tilted. Said, with the tilt angle (the
-    // shift of the last slice against its distance along the normal).
-    double offPlane = 0.0, lastOff = 0.0;
-    for (const FileHeader& h : files)
-    {
-      double d[3];
-      for (int a = 0; a < 3; ++a)
-      {
-        d[a] = h.Position[a] - first.Position[a];
-      }
-      const double along = vtkMath::Dot(d, normal);
-      for (int a = 0; a < 3; ++a)
-      {
-        d[a] -= along * normal[a];
-      }
-      offPlane = std::max(offPlane, vtkMath::Norm(d));
-      lastOff = vtkMath::Norm(d);
-    }
-    if (offPlane > std::max(1e-3 * sliceSpacing, 1e-3))
-    {
-      const double tilt = vtkMath::DegreesFromRadians(std::atan2(lastOff, extentAlong));
-      warnings << "the slices of " << directory << " are shifted within their planes by up to "
-               << Describe(offPlane) << " mm: a gantry tilt of " << Describe(tilt)
-               << " degrees (or slices that do not line up); the volume is read as if they were "
-               << "stacked along the slice normal, so what it shows is sheared by that angle\n";
+      scan.Deviation =
+        std::max(scan.Deviation, std::fabs(offsets[f] - offsets[f - 1] - scan.SliceSpacing));
     }
     for (int a = 0; a < 3; ++a)
     {
-      origin[a] = files.front().Position[a];
+      scan.Origin[a] += offsets.front() * scan.Normal[a];
     }
-    for (const FileHeader& h : files)
+    if (scan.SliceSpacing < 0)
     {
-      slices.push_back(Slice{ h.Path, 0, h.Slope, h.Intercept });
+      message = first.Path + " has a decreasing GridFrameOffsetVector";
+      return false;
     }
   }
-
-  // PASS 5: the output type from the stored range and every slice's rescale.
-  bool integral = true;
-  double lo = VTK_DOUBLE_MAX, hi = VTK_DOUBLE_MIN;
-  const double storedLo = first.PixelRepresentation ? -std::ldexp(1.0, first.BitsStored - 1) : 0.0;
-  const double storedHi = first.PixelRepresentation ? std::ldexp(1.0, first.BitsStored - 1) - 1
-                                                    : std::ldexp(1.0, first.BitsStored) - 1;
-  int type;
-  if (first.Samples == 3)
+  else if (first.SpacingBetweenSlices > 0)
   {
-    type = first.BitsAllocated == 8
-      ? VTK_UNSIGNED_CHAR
-      : (first.BitsAllocated == 16 ? VTK_UNSIGNED_SHORT : VTK_UNSIGNED_INT);
+    scan.SliceSpacing = first.SpacingBetweenSlices;
+  }
+  else if (first.SliceThickness > 0)
+  {
+    scan.SliceSpacing = first.SliceThickness;
+    scan.Warnings << first.Path << " has " << first.Frames << " frames without "
+                  << "SpacingBetweenSlices: spaced by their SliceThickness, "
+                  << Describe(scan.SliceSpacing) << " mm\n";
   }
   else
   {
-    for (const Slice& s : slices)
-    {
-      integral =
-        integral && s.Slope == std::floor(s.Slope) && s.Intercept == std::floor(s.Intercept);
-      const double a = s.Slope * storedLo + s.Intercept, b = s.Slope * storedHi + s.Intercept;
-      lo = std::min(lo, std::min(a, b));
-      hi = std::max(hi, std::max(a, b));
-    }
-    type = ChooseScalarType(integral, lo, hi, first.BitsStored > 24);
+    scan.Warnings << first.Path << " has " << first.Frames << " frames and no slice spacing: "
+                  << "spaced by 1 mm\n";
   }
+  if (scan.SliceSpacing == 0)
+  {
+    message = first.Path + " has frames at one position (a zero frame spacing)";
+    return false;
+  }
+  return true;
+}
 
-  double spacing[3] = { first.PixelSpacing[1], first.PixelSpacing[0], std::fabs(sliceSpacing) };
+/// PASS 5 for several files, first step: the files sorted by their position along the slice
+/// normal; two at one position are an error.
+bool SortAlongNormal(std::vector<FileHeader>& files, const double normal[3], std::string& message)
+{
+  for (FileHeader& h : files)
+  {
+    h.Projection = vtkMath::Dot(h.Position, normal);
+  }
+  std::stable_sort(files.begin(), files.end(),
+    [](const FileHeader& a, const FileHeader& b) { return a.Projection < b.Projection; });
+  const double extentAlong = files.back().Projection - files.front().Projection;
+  const double tolerance = std::max(1e-4, 1e-6 * std::fabs(extentAlong));
+  for (std::size_t s = 1; s < files.size(); ++s)
+  {
+    if (files[s].Projection - files[s - 1].Projection <= tolerance)
+    {
+      message = files[s].Path + " and " + files[s - 1].Path + " are at the same position (" +
+        Describe(files[s].Projection) + " mm along the slice normal): duplicated slice " +
+        "positions (two acquisitions in one series?)";
+      return false;
+    }
+  }
+  return true;
+}
+
+/// PASS 5 for several sorted files: the mean slice spacing and the largest deviation from it.
+/// Slices are never stacked as if evenly spaced when they are not (a missing slice, a variable
+/// spacing): under 1% of the mean gap, a warning with the spread; beyond, an error that names
+/// the gap.
+bool CheckSliceSpacing(SeriesScan& scan, std::string& message)
+{
+  const std::vector<FileHeader>& files = scan.Files;
+  const double extentAlong = files.back().Projection - files.front().Projection;
+  const double mean = extentAlong / (files.size() - 1);
+  double deviation = 0.0;
+  std::size_t worst = 1;
+  double smallest = extentAlong, largest = 0.0;
+  for (std::size_t s = 1; s < files.size(); ++s)
+  {
+    const double gap = files[s].Projection - files[s - 1].Projection;
+    smallest = std::min(smallest, gap);
+    largest = std::max(largest, gap);
+    if (std::fabs(gap - mean) > deviation)
+    {
+      deviation = std::fabs(gap - mean);
+      worst = s;
+    }
+  }
+  if (deviation >= 0.01 * mean)
+  {
+    message = "the slices of " + scan.Directory +
+      " are not evenly spaced: " + files[worst - 1].Path + " and " + files[worst].Path + " are " +
+      Describe(files[worst].Projection - files[worst - 1].Projection) +
+      " mm apart along the slice normal (at " + Describe(files[worst - 1].Projection) + " and " +
+      Describe(files[worst].Projection) + " mm), the mean gap is " + Describe(mean) +
+      " mm (a missing slice, or a variable spacing); gaps range from " + Describe(smallest) +
+      " to " + Describe(largest) + " mm" +
+      (scan.LeftOut.empty() ? std::string()
+                            : "; left out of this stack as another acquisition: " + scan.LeftOut);
+    return false;
+  }
+  if (deviation > std::max(1e-3 * mean, 1e-4))
+  {
+    scan.Warnings << "irregular slice spacing in " << scan.Directory << ": the gaps between "
+                  << "slices range from " << Describe(smallest) << " to " << Describe(largest)
+                  << " mm (mean " << Describe(mean) << " mm; largest deviation "
+                  << Describe(deviation) << " mm, at " << BaseName(files[worst].Path)
+                  << ", under 1%); the volume is read with the mean spacing\n";
+  }
+  scan.SliceSpacing = mean;
+  scan.Deviation = deviation;
+  return true;
+}
+
+/// PASS 5 for several sorted files: positions off the normal through the first slice cannot be
+/// represented: a stack sheared along its planes is a CT acquired with the gantry tilted. Said,
+/// with the tilt angle (the shift of the last slice against its distance along the normal).
+void WarnOfGantryTilt(SeriesScan& scan)
+{
+  const std::vector<FileHeader>& files = scan.Files;
+  const FileHeader& first = files.front();
+  const double extentAlong = files.back().Projection - first.Projection;
+  double offPlane = 0.0, lastOff = 0.0;
+  for (const FileHeader& h : files)
+  {
+    double d[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      d[a] = h.Position[a] - first.Position[a];
+    }
+    const double along = vtkMath::Dot(d, scan.Normal);
+    for (int a = 0; a < 3; ++a)
+    {
+      d[a] -= along * scan.Normal[a];
+    }
+    offPlane = std::max(offPlane, vtkMath::Norm(d));
+    lastOff = vtkMath::Norm(d);
+  }
+  if (offPlane > std::max(1e-3 * scan.SliceSpacing, 1e-3))
+  {
+    const double tilt = vtkMath::DegreesFromRadians(std::atan2(lastOff, extentAlong));
+    scan.Warnings << "the slices of " << scan.Directory << " are shifted within their planes by "
+                  << "up to " << Describe(offPlane) << " mm: a gantry tilt of " << Describe(tilt)
+                  << " degrees (or slices that do not line up); the volume is read as if they "
+                  << "were stacked along the slice normal, so what it shows is sheared by that "
+                  << "angle\n";
+  }
+}
+
+/// PASS 5 for a series of several files: a slice per file, sorted along the normal, evenly
+/// spaced, from the first one's position.
+bool PlaceFiles(SeriesScan& scan, std::string& message)
+{
+  if (!SortAlongNormal(scan.Files, scan.Normal, message) || !CheckSliceSpacing(scan, message))
+  {
+    return false;
+  }
+  WarnOfGantryTilt(scan);
+  const FileHeader& first = scan.Files.front();
+  std::copy(first.Position, first.Position + 3, scan.Origin);
+  for (const FileHeader& h : scan.Files)
+  {
+    scan.Slices.push_back(Slice{ h.Path, 0, h.Slope, h.Intercept });
+  }
+  return true;
+}
+
+/// PASS 5: geometry: the axes, the slices in order along the normal, the spacing and the origin
+/// (the first slice's position).
+bool PlaceSlices(SeriesScan& scan, std::string& message)
+{
+  if (!FindAxes(scan, message) ||
+    !(scan.Files.size() == 1 ? PlaceFrames(scan, message) : PlaceFiles(scan, message)))
+  {
+    return false;
+  }
+  const FileHeader& first = scan.Files.front();
+  scan.Dimensions[0] = first.Columns;
+  scan.Dimensions[1] = first.Rows;
+  scan.Dimensions[2] = static_cast<int>(scan.Slices.size());
+  scan.Spacing[0] = first.PixelSpacing[1];
+  scan.Spacing[1] = first.PixelSpacing[0];
+  scan.Spacing[2] = std::fabs(scan.SliceSpacing);
   if (!first.HasSpacing)
   {
-    warnings << first.Path << " has no PixelSpacing: 1 mm is used\n";
+    scan.Warnings << first.Path << " has no PixelSpacing: 1 mm is used\n";
   }
-  const bool isCT = first.Modality == "CT";
+  return true;
+}
+
+/// The range of the rescaled samples, whether they are all integers, and whether float cannot
+/// hold the stored values.
+struct SampleRange
+{
+  bool Integral = true;
+  double Lo = VTK_DOUBLE_MAX, Hi = VTK_DOUBLE_MIN;
+  bool Wide = false;
+};
+
+/// PASS 6, for one sample per pixel: the stored range under every slice's rescale.
+SampleRange RescaledRange(const FileHeader& first, const std::vector<Slice>& slices)
+{
+  SampleRange range;
+  range.Wide = first.BitsStored > 24;
+  const double storedLo = first.PixelRepresentation ? -std::ldexp(1.0, first.BitsStored - 1) : 0.0;
+  const double storedHi = first.PixelRepresentation ? std::ldexp(1.0, first.BitsStored - 1) - 1
+                                                    : std::ldexp(1.0, first.BitsStored) - 1;
+  for (const Slice& s : slices)
+  {
+    range.Integral =
+      range.Integral && s.Slope == std::floor(s.Slope) && s.Intercept == std::floor(s.Intercept);
+    const double a = s.Slope * storedLo + s.Intercept, b = s.Slope * storedHi + s.Intercept;
+    range.Lo = std::min(range.Lo, std::min(a, b));
+    range.Hi = std::max(range.Hi, std::max(a, b));
+  }
+  return range;
+}
+
+/// PASS 6, for colour images (unscaled): the type of their stored samples.
+int ColourScalarType(int bitsAllocated)
+{
+  return bitsAllocated == 8 ? VTK_UNSIGNED_CHAR
+                            : (bitsAllocated == 16 ? VTK_UNSIGNED_SHORT : VTK_UNSIGNED_INT);
+}
+
+/// The scan in words, for the log: the series, its size, spacing, transfer syntax and rescale.
+std::string Summarize(const SeriesScan& scan)
+{
+  const FileHeader& first = scan.Files.front();
   std::ostringstream summary;
-  summary << "DICOM series " << chosenUID << " (" << (first.Modality.empty() ? "?" : first.Modality)
-          << "): " << first.Columns << " x " << first.Rows << " x " << slices.size() << ", spacing "
-          << Describe(spacing[0]) << " x " << Describe(spacing[1]) << " x " << Describe(spacing[2])
+  summary << "DICOM series " << scan.ChosenUID << " ("
+          << (first.Modality.empty() ? "?" : first.Modality) << "): " << first.Columns << " x "
+          << first.Rows << " x " << scan.Slices.size() << ", spacing " << Describe(scan.Spacing[0])
+          << " x " << Describe(scan.Spacing[1]) << " x " << Describe(scan.Spacing[2])
           << " mm, transfer syntax " << TransferSyntaxName(first.TransferSyntaxUID) << ", rescale "
           << Describe(first.Slope) << " * stored " << (first.Intercept < 0 ? "- " : "+ ")
           << Describe(std::fabs(first.Intercept));
+  return summary.str();
+}
 
-  rgmc::Packer p;
-  const int dimensions[3] = { first.Columns, first.Rows, static_cast<int>(slices.size()) };
-  double direction[9]; // row-major 3x3, columns row/col/normal
-  for (int a = 0; a < 3; ++a)
-  {
-    direction[3 * a] = row[a];
-    direction[3 * a + 1] = col[a];
-    direction[3 * a + 2] = normal[a];
-  }
-  PackGeometry(p, dimensions, spacing, origin, direction, type);
+/// What follows the geometry in the header, in the order Parse reads it: the pixel description,
+/// the scan's words and every slice.
+void PackSeries(rgmc::Packer& p, const SeriesScan& scan)
+{
+  const FileHeader& first = scan.Files.front();
   p.Number(first.Samples).Number(first.Planar).Number(first.BitsAllocated);
   p.Number(first.BitsStored).Number(first.PixelRepresentation).Number(first.TransferSyntax);
-  p.Number(deviation).Number(static_cast<double>(files.size()));
-  p.String(isCT ? "HU" : "Intensity").String(list.str()).String(warnings.str());
-  p.String(summary.str()).String(first.Photometric);
+  p.Number(scan.Deviation).Number(static_cast<double>(scan.Files.size()));
+  p.String(first.Modality == "CT" ? "HU" : "Intensity")
+    .String(scan.SeriesList)
+    .String(scan.Warnings.str());
+  p.String(Summarize(scan)).String(first.Photometric);
   p.Number(first.Encapsulated ? 1 : 0).Number(first.Frames);
-  for (const Slice& s : slices)
+  for (const Slice& s : scan.Slices)
   {
     p.String(s.Path).Number(s.Frame).Number(s.Slope).Number(s.Intercept);
   }
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+// Rank 0 alone runs the scan, and it makes no collective call: vtkRGVolumeReader's
+// RequestInformation agrees on its status over all ranks, then broadcasts the header it writes.
+//
+//  PASS 1 ReadHeaders   every file's header (GDCM stops before the pixel data)
+//  PASS 2 ChooseSeries  the series named, else FileName's, else the one with the most files
+//  PASS 3 ChooseStack   the largest stack of the series (localizers and the like left out)
+//  PASS 4 CheckSeries   one size, pixel format, orientation and pixel spacing for all
+//  PASS 5 PlaceSlices   the axes, the slices sorted along the normal, their spacing, the origin
+//  PASS 6               the output type; the header: geometry, pixel description, slices
+bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
+{
+  SeriesScan scan;
+  scan.Name = this->FileName;
+  scan.ChosenUID = this->SeriesInstanceUID ? this->SeriesInstanceUID : "";
+  // PASS 1: every file's header, in name order (a stable order for the messages).
+  if (!ReadHeaders(scan, message))
+  {
+    return false;
+  }
+  // PASS 2: series by SeriesInstanceUID; the chosen one, else the largest (ties: smallest UID).
+  if (!ChooseSeries(scan, message))
+  {
+    return false;
+  }
+  // PASS 3: the largest stack of images alike in the series; the others named in a warning.
+  ChooseStack(scan);
+  // PASS 4: one volume's worth of consistency, each mismatch naming its file.
+  if (!CheckSeries(scan.Files, message))
+  {
+    return false;
+  }
+  // PASS 5: geometry, in DICOM's patient coordinates.
+  if (!PlaceSlices(scan, message))
+  {
+    return false;
+  }
+  // PASS 6: the output type from the stored range and every slice's rescale; the header.
+  const FileHeader& first = scan.Files.front();
+  const SampleRange range = RescaledRange(first, scan.Slices);
+  const int type = first.Samples == 3
+    ? ColourScalarType(first.BitsAllocated)
+    : ChooseScalarType(range.Integral, range.Lo, range.Hi, range.Wide);
+  rgmc::Packer p;
+  PackGeometry(p, scan.Dimensions, scan.Spacing, scan.Origin, scan.Direction, type);
+  PackSeries(p, scan);
   header = p.Text;
   return true;
 }
@@ -1051,25 +1278,26 @@ bool vtkRGDICOMSeriesReader::Parse(const std::string& header, std::string& messa
 {
   rgmc::Unpacker u(header);
   Internals& in = *this->Internal;
+  PixelDescription& pixels = in.Pixels;
   this->UnpackGeometry(u);
-  in.Samples = u.Int();
-  in.Planar = u.Int();
-  in.BitsAllocated = u.Int();
-  in.BitsStored = u.Int();
-  in.PixelRepresentation = u.Int();
-  in.TransferSyntax = u.Int();
+  pixels.Samples = u.Int();
+  pixels.Planar = u.Int();
+  pixels.BitsAllocated = u.Int();
+  pixels.BitsStored = u.Int();
+  pixels.PixelRepresentation = u.Int();
+  pixels.TransferSyntax = u.Int();
   this->LargestSpacingDeviation = u.Number();
   in.Files = static_cast<std::size_t>(u.Number());
   this->ArrayName = u.String();
   this->SeriesList = u.String();
   this->Warnings = u.String();
   this->Summary = u.String();
-  in.Photometric = u.String();
-  in.Encapsulated = u.Int() != 0;
-  in.Frames = u.Int();
-  in.Columns = this->Dimensions[0];
-  in.Rows = this->Dimensions[1];
-  this->NumberOfComponents = in.Samples;
+  pixels.Photometric = u.String();
+  pixels.Encapsulated = u.Int() != 0;
+  pixels.Frames = u.Int();
+  pixels.Columns = this->Dimensions[0];
+  pixels.Rows = this->Dimensions[1];
+  this->NumberOfComponents = pixels.Samples;
   in.Slices.assign(static_cast<std::size_t>(std::max(0, this->Dimensions[2])), Slice());
   for (Slice& s : in.Slices)
   {
@@ -1089,235 +1317,340 @@ bool vtkRGDICOMSeriesReader::Parse(const std::string& header, std::string& messa
   return true;
 }
 
+namespace
+{
+
+/// The pixel data of the file decoded last (a multi-frame file serves several slices).
+struct DecodedFile
+{
+  std::string Path;        // empty before the first file
+  std::vector<char> Bytes; // every frame, samples in this host's byte order
+  int Planar = 0;          // the planar configuration of Bytes (a codec may interleave samples)
+};
+
+/// Bytes of one decoded frame: decoders give full frames; native YBR_FULL_422 stays subsampled
+/// (FrameLayout expands it).
+std::size_t DecodedFrameBytes(const PixelDescription& pixels)
+{
+  return pixels.Encapsulated
+    ? NativeFrameBytes(pixels.Rows, pixels.Columns, pixels.Samples, pixels.BitsAllocated, "")
+    : NativeFrameBytes(
+        pixels.Rows, pixels.Columns, pixels.Samples, pixels.BitsAllocated, pixels.Photometric);
+}
+
+/// Native pixel data: read straight from the file, swapped to this host's byte order. The byte
+/// order applies to the value's words: 8-bit samples in an OW value come in swapped pairs in big
+/// endian (pydicom 2.4's SC_rgb_small_odd_big_endian.dcm), the last one with the value's padding
+/// byte when the sample count is odd.
+bool ReadNativePixels(const std::string& path, const PixelDescription& pixels,
+  const rgmc::DicomStructure& structure, std::size_t frameBytes, DecodedFile& decoded)
+{
+  const std::size_t expected = frameBytes * pixels.Frames;
+  int word = pixels.BitsAllocated == 1 ? 1 : pixels.BitsAllocated / 8; // bits stay in bytes
+  if (pixels.BitsAllocated == 8 && structure.PixelDataWords)
+  {
+    word = 2;
+  }
+  const bool swap = structure.BigEndian && word > 1;
+  const std::size_t padded =
+    swap && expected % word != 0 && structure.PixelDataLength >= expected + word - expected % word
+    ? expected + word - expected % word
+    : expected;
+  std::vector<char>& buffer = decoded.Bytes;
+  std::ifstream file(path, std::ios::binary);
+  buffer.assign(padded, 0);
+  file.seekg(static_cast<std::streamoff>(structure.PixelDataOffset));
+  const bool read =
+    static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(padded)));
+  if (swap)
+  {
+    for (std::size_t b = 0; b + word <= buffer.size(); b += word)
+    {
+      std::reverse(buffer.begin() + b, buffer.begin() + b + word);
+    }
+  }
+  buffer.resize(expected);
+  decoded.Planar = pixels.Planar;
+  return read;
+}
+
+/// RLE Lossless, decoded here: GDCM 3.0.21 orders the bytes of 16- and 32-bit colour RLE
+/// wrongly. False with `problem` when the pixel data is malformed.
+bool DecodeRle(const std::string& path, const PixelDescription& pixels,
+  const rgmc::DicomStructure& structure, std::size_t frameBytes, DecodedFile& decoded,
+  std::string& problem)
+{
+  const std::size_t pixelsPerFrame = static_cast<std::size_t>(pixels.Rows) * pixels.Columns;
+  bool ok = structure.Fragments.size() == static_cast<std::size_t>(pixels.Frames);
+  problem = "it has " + std::to_string(structure.Fragments.size()) + " RLE fragments for " +
+    std::to_string(pixels.Frames) + " frames";
+  decoded.Bytes.assign(frameBytes * pixels.Frames, 0);
+  for (int f = 0; ok && f < pixels.Frames; ++f)
+  {
+    ok = rgmc::DecodeRleFrame(path, structure.Fragments[f].first, structure.Fragments[f].second,
+      pixelsPerFrame, pixels.Samples, pixels.BitsAllocated / 8,
+      decoded.Bytes.data() + frameBytes * f, problem);
+  }
+  decoded.Planar = 0;
+  return ok;
+}
+
+bool IsJpeg(int transferSyntax)
+{
+  return transferSyntax == gdcm::TransferSyntax::JPEGBaselineProcess1 ||
+    transferSyntax == gdcm::TransferSyntax::JPEGExtendedProcess2_4 ||
+    transferSyntax == gdcm::TransferSyntax::JPEGLosslessProcess14 ||
+    transferSyntax == gdcm::TransferSyntax::JPEGLosslessProcess14_1;
+}
+
+/// The header of each JPEG frame (a fragment that starts with a start-of-image marker, and the
+/// first fragment), checked before GDCM's codec sees it; false with `problem` when one is broken.
+bool CheckJpegFrames(const std::string& path, const PixelDescription& pixels,
+  const rgmc::DicomStructure& structure, std::string& problem)
+{
+  for (const auto& fragment : structure.Fragments)
+  {
+    std::string why;
+    char start[2] = { 0, 0 };
+    std::ifstream file(path, std::ios::binary);
+    file.seekg(static_cast<std::streamoff>(fragment.first));
+    file.read(start, 2);
+    const bool frameStart =
+      static_cast<unsigned char>(start[0]) == 0xff && static_cast<unsigned char>(start[1]) == 0xd8;
+    if ((frameStart || &fragment == &structure.Fragments.front()) &&
+      !rgmc::CheckJpegHeader(path, fragment.first, fragment.second, pixels.Rows, pixels.Columns,
+        pixels.Samples, pixels.BitsStored, why))
+    {
+      problem = why;
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The pixel data of `file` as a GDCM image, described by the header scan (not guessed).
+void DescribeImage(const PixelDescription& pixels, const gdcm::File& file, gdcm::Image& image)
+{
+  image.SetNumberOfDimensions(pixels.Frames > 1 ? 3 : 2);
+  image.SetDimension(0, static_cast<unsigned>(pixels.Columns));
+  image.SetDimension(1, static_cast<unsigned>(pixels.Rows));
+  if (pixels.Frames > 1)
+  {
+    image.SetDimension(2, static_cast<unsigned>(pixels.Frames));
+  }
+  image.SetPixelFormat(gdcm::PixelFormat(static_cast<unsigned short>(pixels.Samples),
+    static_cast<unsigned short>(pixels.BitsAllocated),
+    static_cast<unsigned short>(pixels.BitsStored),
+    static_cast<unsigned short>(pixels.BitsStored - 1),
+    static_cast<unsigned short>(pixels.PixelRepresentation)));
+  const gdcm::PhotometricInterpretation::PIType pi =
+    gdcm::PhotometricInterpretation::GetPIType(pixels.Photometric.c_str());
+  image.SetPhotometricInterpretation(pi == gdcm::PhotometricInterpretation::PI_END
+      ? gdcm::PhotometricInterpretation(gdcm::PhotometricInterpretation::MONOCHROME2)
+      : gdcm::PhotometricInterpretation(pi));
+  if (pixels.Samples == 3)
+  {
+    image.SetPlanarConfiguration(static_cast<unsigned>(pixels.Planar));
+  }
+  image.SetTransferSyntax(file.GetHeader().GetDataSetTransferSyntax());
+  image.SetDataElement(file.GetDataSet().GetDataElement(PixelDataTag));
+}
+
+/// GDCM's parser and codecs, given the pixel description of the header scan (its ImageReader
+/// also guesses geometry, and asserts on some valid files while doing so). Bytes after the last
+/// element (padding, junk) are not GDCM's to parse: it gets the data set alone.
+bool DecodeWithGdcm(const std::string& path, const PixelDescription& pixels,
+  const rgmc::DicomStructure& structure, std::size_t frameBytes, DecodedFile& decoded)
+{
+  gdcm::Reader reader;
+  std::istringstream dataSet;
+  if (structure.TrailingBytes > 0)
+  {
+    std::string bytes(static_cast<std::size_t>(structure.DataSetEnd), '\0');
+    std::ifstream file(path, std::ios::binary);
+    file.read(&bytes[0], static_cast<std::streamsize>(bytes.size()));
+    dataSet.str(bytes);
+    reader.SetStream(dataSet);
+  }
+  else
+  {
+    reader.SetFileName(path.c_str());
+  }
+  try
+  {
+    if (!reader.Read() || !reader.GetFile().GetDataSet().FindDataElement(PixelDataTag))
+    {
+      return false;
+    }
+    gdcm::Image image;
+    DescribeImage(pixels, reader.GetFile(), image);
+    decoded.Bytes.assign(
+      std::max<std::size_t>(image.GetBufferLength(), frameBytes * pixels.Frames), 0);
+    const bool ok = image.GetBuffer(decoded.Bytes.data());
+    // A codec may hand back interleaved samples whatever the header said.
+    decoded.Planar = pixels.Samples == 3 ? static_cast<int>(image.GetPlanarConfiguration()) : 0;
+    return ok;
+  }
+  catch (...)
+  {
+    return false;
+  }
+}
+
+/// Decodes every frame of the file at `path` into `decoded`; false with `message` (naming the
+/// file) when it is truncated, corrupt or not decodable. The file may have changed since the
+/// scan: GDCM sees it only if its structure holds.
+bool DecodeFile(const std::string& path, const PixelDescription& pixels, DecodedFile& decoded,
+  std::string& message)
+{
+  const rgmc::DicomStructure structure = rgmc::WalkDicom(path);
+  if (!structure.Valid || !structure.HasPixelData ||
+    structure.PixelDataEncapsulated != pixels.Encapsulated)
+  {
+    message = path + " is truncated or corrupt: " +
+      (structure.Problem.empty() ? std::string("its pixel data changed since the header scan")
+                                 : structure.Problem);
+    return false;
+  }
+  const std::size_t frameBytes = DecodedFrameBytes(pixels);
+  const std::size_t expected = frameBytes * pixels.Frames;
+  if (!pixels.Encapsulated && structure.PixelDataLength < expected)
+  {
+    message = path + " is truncated: its pixel data has " +
+      std::to_string(structure.PixelDataLength) + " bytes of the " + std::to_string(expected) +
+      " its header announces";
+    return false;
+  }
+  bool ok = false;
+  std::string problem;
+  if (!pixels.Encapsulated && structure.PixelDataOffset > 0)
+  {
+    ok = ReadNativePixels(path, pixels, structure, frameBytes, decoded);
+  }
+  else if (pixels.TransferSyntax == gdcm::TransferSyntax::RLELossless && pixels.BitsAllocated >= 8)
+  {
+    if (!DecodeRle(path, pixels, structure, frameBytes, decoded, problem))
+    {
+      message = path + " has malformed RLE pixel data: " + problem;
+      return false;
+    }
+    ok = true;
+  }
+  else if (IsJpeg(pixels.TransferSyntax) && !CheckJpegFrames(path, pixels, structure, problem))
+  {
+    message = path + " has broken JPEG data: " + problem;
+    return false;
+  }
+  else
+  {
+    ok = DecodeWithGdcm(path, pixels, structure, frameBytes, decoded);
+  }
+  if (!ok)
+  {
+    message = path + " cannot be decoded by GDCM (transfer syntax " +
+      TransferSyntaxName(gdcm::TransferSyntax::GetTSString(
+        static_cast<gdcm::TransferSyntax::TSType>(pixels.TransferSyntax))) +
+      "): truncated or corrupt pixel data";
+    return false;
+  }
+  decoded.Path = path;
+  return true;
+}
+
+/// Where sample c of pixel (i, j) lies in a decoded frame, counted in samples: interleaved,
+/// planar (planar configuration 1 stores each colour plane after the other) or, for native
+/// YBR_FULL_422, subsampled (Y0 Y1 Cb Cr for each pair of pixels of a row).
+class FrameLayout
+{
+public:
+  FrameLayout(const PixelDescription& pixels, int decodedPlanar)
+    : Columns(static_cast<std::size_t>(pixels.Columns))
+    , Samples(pixels.Samples)
+    , PixelsPerFrame(static_cast<std::size_t>(pixels.Rows) * pixels.Columns)
+    , Planar(pixels.Samples == 3 && decodedPlanar == 1)
+    , Subsampled(
+        !pixels.Encapsulated && pixels.Samples == 3 && pixels.Photometric == "YBR_FULL_422")
+  {
+  }
+
+  std::size_t Index(int i, int j, int c) const
+  {
+    if (this->Subsampled)
+    {
+      const std::size_t pair = (static_cast<std::size_t>(j) * this->Columns + (i & ~1)) * 2;
+      return c == 0 ? pair + (i & 1) : pair + 1 + c;
+    }
+    const std::size_t pixel = static_cast<std::size_t>(j) * this->Columns + i;
+    return this->Planar ? c * this->PixelsPerFrame + pixel : pixel * this->Samples + c;
+  }
+
+private:
+  std::size_t Columns;
+  int Samples;
+  std::size_t PixelsPerFrame;
+  bool Planar;
+  bool Subsampled;
+};
+
+/// The stored value of the sample at `index` of a decoded frame: its stored bits, sign-extended
+/// from the highest one when the samples are signed.
+double StoredSample(const PixelDescription& pixels, const char* frame, std::size_t index)
+{
+  if (pixels.BitsAllocated == 1)
+  {
+    return (static_cast<unsigned char>(frame[index / 8]) >> (index % 8)) & 1;
+  }
+  const std::size_t bytes = pixels.BitsAllocated / 8;
+  std::uint32_t raw = 0;
+  std::memcpy(&raw, frame + index * bytes, bytes); // little endian host, as GDCM's
+  if (pixels.PixelRepresentation)
+  {
+    const unsigned width32 = 32 - pixels.BitsStored;
+    return static_cast<double>(static_cast<std::int32_t>(raw << width32) >> width32);
+  }
+  return pixels.BitsStored >= 32 ? raw : (raw & ((std::uint32_t(1) << pixels.BitsStored) - 1));
+}
+
+} // namespace
+
 //------------------------------------------------------------------------------
+// No collective call here: vtkRGVolumeReader's RequestData agrees on the status over all ranks.
 bool vtkRGDICOMSeriesReader::ReadExtent(
   const int extent[6], vtkDataArray* scalars, std::string& message)
 {
-  Internals& in = *this->Internal;
-  const int samples = in.Samples;
-  const std::size_t bytes = in.BitsAllocated == 1 ? 0 : in.BitsAllocated / 8;
-  const std::size_t pixelsPerFrame = static_cast<std::size_t>(in.Rows) * in.Columns;
-  const bool encapsulated = in.Encapsulated;
-  // Decoders give full frames; native YBR_FULL_422 stays subsampled (expanded below).
-  const bool subsampled = !encapsulated && samples == 3 && in.Photometric == "YBR_FULL_422";
-  const std::size_t frameBytes = encapsulated
-    ? NativeFrameBytes(in.Rows, in.Columns, samples, in.BitsAllocated, std::string())
-    : NativeFrameBytes(in.Rows, in.Columns, samples, in.BitsAllocated, in.Photometric);
+  const Internals& in = *this->Internal;
+  const PixelDescription& pixels = in.Pixels;
+  const std::size_t frameBytes = DecodedFrameBytes(pixels);
   const int width = extent[1] - extent[0] + 1;
-  std::vector<double> values(static_cast<std::size_t>(width) * samples);
-  std::vector<char> buffer;
-  std::string loaded; // the file in `buffer` (a multi-frame file serves several slices)
-  int decodedPlanar = in.Planar;
+  std::vector<double> values(static_cast<std::size_t>(width) * pixels.Samples);
+  DecodedFile decoded;
+  decoded.Planar = pixels.Planar;
   vtkIdType at = 0;
   this->NumberOfFilesRead = 0;
-
   for (int k = extent[4]; k <= extent[5]; ++k)
   {
+    // PASS 1, once per file: decode every frame of the slice's file.
     const Slice& slice = in.Slices[k];
-    if (slice.Path != loaded)
+    if (slice.Path != decoded.Path)
     {
-      // The file may have changed since the scan: GDCM sees it only if its structure holds.
-      const rgmc::DicomStructure structure = rgmc::WalkDicom(slice.Path);
-      if (!structure.Valid || !structure.HasPixelData ||
-        structure.PixelDataEncapsulated != encapsulated)
+      if (!DecodeFile(slice.Path, pixels, decoded, message))
       {
-        message = slice.Path + " is truncated or corrupt: " +
-          (structure.Problem.empty() ? std::string("its pixel data changed since the header scan")
-                                     : structure.Problem);
         return false;
       }
-      const std::size_t expected = frameBytes * in.Frames;
-      if (!encapsulated && structure.PixelDataLength < expected)
-      {
-        message = slice.Path + " is truncated: its pixel data has " +
-          std::to_string(structure.PixelDataLength) + " bytes of the " + std::to_string(expected) +
-          " its header announces";
-        return false;
-      }
-      bool decoded = false;
-      if (!encapsulated && structure.PixelDataOffset > 0)
-      {
-        // Native pixel data: read straight from the file, swapped to this host's byte order.
-        // The byte order applies to the value's words: 8-bit samples in an OW value come in
-        // swapped pairs in big endian (pydicom 2.4's SC_rgb_small_odd_big_endian.dcm), the last
-        // one with the value's padding byte when the sample count is odd.
-        int word = in.BitsAllocated == 1 ? 1 : in.BitsAllocated / 8; // bits stay in bytes
-        if (in.BitsAllocated == 8 && structure.PixelDataWords)
-        {
-          word = 2;
-        }
-        const bool swap = structure.BigEndian && word > 1;
-        const std::size_t padded = swap && expected % word != 0 &&
-            structure.PixelDataLength >= expected + word - expected % word
-          ? expected + word - expected % word
-          : expected;
-        std::ifstream file(slice.Path, std::ios::binary);
-        buffer.assign(padded, 0);
-        file.seekg(static_cast<std::streamoff>(structure.PixelDataOffset));
-        decoded = static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(padded)));
-        if (swap)
-        {
-          for (std::size_t b = 0; b + word <= buffer.size(); b += word)
-          {
-            std::reverse(buffer.begin() + b, buffer.begin() + b + word);
-          }
-        }
-        buffer.resize(expected);
-        decodedPlanar = in.Planar;
-      }
-      else if (in.TransferSyntax == gdcm::TransferSyntax::RLELossless && in.BitsAllocated >= 8)
-      {
-        // RLE ourselves: GDCM 3.0.21 orders the bytes of 16- and 32-bit colour RLE wrongly.
-        decoded = structure.Fragments.size() == static_cast<std::size_t>(in.Frames);
-        std::string problem = "it has " + std::to_string(structure.Fragments.size()) +
-          " RLE fragments for " + std::to_string(in.Frames) + " frames";
-        buffer.assign(expected, 0);
-        for (int f = 0; decoded && f < in.Frames; ++f)
-        {
-          decoded = rgmc::DecodeRleFrame(slice.Path, structure.Fragments[f].first,
-            structure.Fragments[f].second, pixelsPerFrame, samples, in.BitsAllocated / 8,
-            buffer.data() + frameBytes * f, problem);
-        }
-        if (!decoded)
-        {
-          message = slice.Path + " has malformed RLE pixel data: " + problem;
-          return false;
-        }
-        decodedPlanar = 0;
-      }
-      else
-      {
-        const int ts = in.TransferSyntax;
-        if (ts == gdcm::TransferSyntax::JPEGBaselineProcess1 ||
-          ts == gdcm::TransferSyntax::JPEGExtendedProcess2_4 ||
-          ts == gdcm::TransferSyntax::JPEGLosslessProcess14 ||
-          ts == gdcm::TransferSyntax::JPEGLosslessProcess14_1)
-        {
-          for (const auto& fragment : structure.Fragments)
-          {
-            std::string problem;
-            char start[2] = { 0, 0 };
-            std::ifstream file(slice.Path, std::ios::binary);
-            file.seekg(static_cast<std::streamoff>(fragment.first));
-            file.read(start, 2);
-            const bool frameStart = static_cast<unsigned char>(start[0]) == 0xff &&
-              static_cast<unsigned char>(start[1]) == 0xd8;
-            if ((frameStart || &fragment == &structure.Fragments.front()) &&
-              !rgmc::CheckJpegHeader(slice.Path, fragment.first, fragment.second, in.Rows,
-                in.Columns, samples, in.BitsStored, problem))
-            {
-              message = slice.Path + " has broken JPEG data: " + problem;
-              return false;
-            }
-          }
-        }
-        // GDCM's parser and codecs, given the pixel description of the header scan (its
-        // ImageReader also guesses geometry, and asserts on some valid files while doing so).
-        // Bytes after the last element (padding, junk) are not GDCM's to parse: it gets the
-        // data set alone.
-        gdcm::Reader reader;
-        std::istringstream dataSet;
-        if (structure.TrailingBytes > 0)
-        {
-          std::string bytes(static_cast<std::size_t>(structure.DataSetEnd), '\0');
-          std::ifstream file(slice.Path, std::ios::binary);
-          file.read(&bytes[0], static_cast<std::streamsize>(bytes.size()));
-          dataSet.str(bytes);
-          reader.SetStream(dataSet);
-        }
-        else
-        {
-          reader.SetFileName(slice.Path.c_str());
-        }
-        try
-        {
-          if (reader.Read() && reader.GetFile().GetDataSet().FindDataElement(PixelDataTag))
-          {
-            gdcm::Image image;
-            image.SetNumberOfDimensions(in.Frames > 1 ? 3 : 2);
-            image.SetDimension(0, static_cast<unsigned>(in.Columns));
-            image.SetDimension(1, static_cast<unsigned>(in.Rows));
-            if (in.Frames > 1)
-            {
-              image.SetDimension(2, static_cast<unsigned>(in.Frames));
-            }
-            image.SetPixelFormat(gdcm::PixelFormat(static_cast<unsigned short>(samples),
-              static_cast<unsigned short>(in.BitsAllocated),
-              static_cast<unsigned short>(in.BitsStored),
-              static_cast<unsigned short>(in.BitsStored - 1),
-              static_cast<unsigned short>(in.PixelRepresentation)));
-            const gdcm::PhotometricInterpretation::PIType pi =
-              gdcm::PhotometricInterpretation::GetPIType(in.Photometric.c_str());
-            image.SetPhotometricInterpretation(pi == gdcm::PhotometricInterpretation::PI_END
-                ? gdcm::PhotometricInterpretation(gdcm::PhotometricInterpretation::MONOCHROME2)
-                : gdcm::PhotometricInterpretation(pi));
-            if (samples == 3)
-            {
-              image.SetPlanarConfiguration(static_cast<unsigned>(in.Planar));
-            }
-            image.SetTransferSyntax(reader.GetFile().GetHeader().GetDataSetTransferSyntax());
-            image.SetDataElement(reader.GetFile().GetDataSet().GetDataElement(PixelDataTag));
-            buffer.assign(std::max<std::size_t>(image.GetBufferLength(), expected), 0);
-            decoded = image.GetBuffer(buffer.data());
-            // A codec may hand back interleaved samples whatever the header said.
-            decodedPlanar = samples == 3 ? static_cast<int>(image.GetPlanarConfiguration()) : 0;
-          }
-        }
-        catch (...)
-        {
-          decoded = false;
-        }
-      }
-      if (!decoded)
-      {
-        message = slice.Path + " cannot be decoded by GDCM (transfer syntax " +
-          TransferSyntaxName(gdcm::TransferSyntax::GetTSString(
-            static_cast<gdcm::TransferSyntax::TSType>(in.TransferSyntax))) +
-          "): truncated or corrupt pixel data";
-        return false;
-      }
-      loaded = slice.Path;
       ++this->NumberOfFilesRead;
     }
-    const char* frame = buffer.data() + frameBytes * slice.Frame;
-    // Planar configuration 1 stores each colour plane after the other.
-    const bool planar = samples == 3 && decodedPlanar == 1;
+    // PASS 2: the rows of the extent in the slice's frame, rescaled (one sample per pixel).
+    const char* frame = decoded.Bytes.data() + frameBytes * slice.Frame;
+    const FrameLayout layout(pixels, decoded.Planar);
     for (int j = extent[2]; j <= extent[3]; ++j)
     {
       std::size_t n = 0;
       for (int i = extent[0]; i <= extent[1]; ++i)
       {
-        for (int c = 0; c < samples; ++c)
+        for (int c = 0; c < pixels.Samples; ++c)
         {
-          const std::size_t pixel = static_cast<std::size_t>(j) * in.Columns + i;
-          std::size_t index = planar ? c * pixelsPerFrame + pixel : pixel * samples + c;
-          if (subsampled)
-          {
-            // Y0 Y1 Cb Cr for each pair of pixels of a row.
-            const std::size_t pair = (static_cast<std::size_t>(j) * in.Columns + (i & ~1)) * 2;
-            index = c == 0 ? pair + (i & 1) : pair + 1 + c;
-          }
-          double v;
-          if (in.BitsAllocated == 1)
-          {
-            v = (static_cast<unsigned char>(frame[index / 8]) >> (index % 8)) & 1;
-          }
-          else
-          {
-            std::uint32_t raw = 0;
-            std::memcpy(&raw, frame + index * bytes, bytes); // little endian host, as GDCM's
-            // Keep the stored bits; a signed value is sign-extended from its highest stored bit.
-            if (in.PixelRepresentation)
-            {
-              const unsigned width32 = 32 - in.BitsStored;
-              v = static_cast<double>(static_cast<std::int32_t>(raw << width32) >> width32);
-            }
-            else
-            {
-              v = in.BitsStored >= 32 ? raw : (raw & ((std::uint32_t(1) << in.BitsStored) - 1));
-            }
-          }
-          values[n++] = samples == 1 ? slice.Slope * v + slice.Intercept : v;
+          const double v = StoredSample(pixels, frame, layout.Index(i, j, c));
+          values[n++] = pixels.Samples == 1 ? slice.Slope * v + slice.Intercept : v;
         }
       }
       Store(scalars, at, values.data(), values.size());

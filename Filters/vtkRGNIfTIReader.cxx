@@ -283,17 +283,40 @@ int vtkRGNIfTIReader::CanReadFile(const char* name)
     : 0;
 }
 
-//------------------------------------------------------------------------------
-bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
+namespace
 {
-  const std::string path = this->FileName;
+
+/// What the header scan has found so far, pass by pass.
+struct VolumeScan
+{
+  std::string Path; // FileName
+  // PASS 1
+  Header Fields;           // the header, in host byte order
+  bool Compressed = false; // a gzip stream (.nii.gz)
+  // PASS 2 and 3
+  int Dimensions[3] = { 1, 1, 1 };
+  int StoredType = 0;    // the VTK type of the stored voxels
+  int BytesPerVoxel = 0; // of the stored voxels
+  // PASS 4
+  double Slope = 1.0, Intercept = 0.0;
+  // PASS 5
+  int GeometryMethod = 1; // which matrix placed the volume: 3 sform, 2 qform, 1 pixdim only
+  double Spacing[3] = { 1, 1, 1 };
+  double Origin[3] = { 0, 0, 0 };
+  double Direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 }; // row-major, LPS
+  std::ostringstream Warnings;                         // one per line
+};
+
+/// PASS 1: the 348-byte header, read through zlib (compressed or not) and parsed.
+bool ReadHeader(VolumeScan& scan, std::string& message)
+{
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error))
+  if (!std::filesystem::is_regular_file(scan.Path, error))
   {
-    message = std::filesystem::exists(path, error) ? "not a file" : "no such file";
+    message = std::filesystem::exists(scan.Path, error) ? "not a file" : "no such file";
     return false;
   }
-  GzFile file(path);
+  GzFile file(scan.Path);
   char raw[HeaderSize];
   const long long got = file.File ? file.Read(0, raw, HeaderSize) : -1;
   if (got < 0)
@@ -306,20 +329,24 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
     message = "is truncated: its header has " + std::to_string(got) + " of 348 bytes";
     return false;
   }
-  Header h;
-  if (!ParseHeader(raw, h, message))
+  if (!ParseHeader(raw, scan.Fields, message))
   {
     return false;
   }
-  std::ostringstream warnings;
+  scan.Compressed = gzdirect(file.File) == 0;
+  return true;
+}
 
-  // Dimensions: x, y, z; a fourth and later dimension beyond 1 gives the first volume.
+/// PASS 2: dimensions x, y, z; a fourth and later dimension beyond 1 gives the first volume.
+bool ReadDimensions(VolumeScan& scan, std::string& message)
+{
+  const Header& h = scan.Fields;
   if (h.Dim[0] < 1 || h.Dim[0] > 7)
   {
     message = "has dim[0] = " + std::to_string(h.Dim[0]) + " (1 to 7 dimensions are valid)";
     return false;
   }
-  int dims[3] = { 1, 1, 1 };
+  int* dims = scan.Dimensions;
   for (int a = 0; a < 3; ++a)
   {
     if (a < h.Dim[0])
@@ -345,10 +372,18 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
   }
   if (volumes > 1)
   {
-    warnings << path << " holds " << volumes << " volumes: the first is read\n";
+    scan.Warnings << scan.Path << " holds " << volumes << " volumes: the first is read\n";
   }
-  int vtkType = 0;
-  const int bytes = DataTypeSize(h.DataType, vtkType);
+  return true;
+}
+
+/// PASS 3: how the voxels are stored (a datatype read, its bitpix, where they start), and, in an
+/// uncompressed file, that they are all there.
+bool CheckVoxelData(VolumeScan& scan, std::string& message)
+{
+  const Header& h = scan.Fields;
+  const int bytes = DataTypeSize(h.DataType, scan.StoredType);
+  scan.BytesPerVoxel = bytes;
   if (bytes == 0)
   {
     message = "has the datatype " + DataTypeName(h.DataType) +
@@ -367,12 +402,13 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
     message = "has vox_offset " + Describe(h.VoxOffset) + " (at least 352, a whole number)";
     return false;
   }
+  const int* dims = scan.Dimensions;
   const std::uint64_t voxels = static_cast<std::uint64_t>(dims[0]) * dims[1] * dims[2];
   const std::uint64_t needed = static_cast<std::uint64_t>(h.VoxOffset) + voxels * bytes;
-  const bool compressed = gzdirect(file.File) == 0;
-  if (!compressed)
+  if (!scan.Compressed)
   {
-    const std::uint64_t size = std::filesystem::file_size(path, error);
+    std::error_code error;
+    const std::uint64_t size = std::filesystem::file_size(scan.Path, error);
     if (!error && size < needed)
     {
       message = "is truncated: it has " + std::to_string(size) + " bytes, its header announces " +
@@ -382,48 +418,93 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
       return false;
     }
   }
+  return true;
+}
 
-  // Scaling: none when scl_slope is 0 or not finite (the standard's rule).
-  double slope = 1.0, intercept = 0.0;
+/// The range of the scaled samples, whether they are all integers, and whether float cannot
+/// hold the stored values.
+struct SampleRange
+{
+  bool Integral = false;
+  double Lo = 0, Hi = 0;
+  bool Wide = false;
+};
+
+/// PASS 4: the scaling, none when scl_slope is 0 or not finite (the standard's rule), and the
+/// range it gives the stored type.
+SampleRange ReadScaling(VolumeScan& scan)
+{
+  const Header& h = scan.Fields;
   if (std::isfinite(h.SclSlope) && h.SclSlope != 0)
   {
-    slope = h.SclSlope;
-    intercept = std::isfinite(h.SclInter) ? h.SclInter : 0.0;
+    scan.Slope = h.SclSlope;
+    scan.Intercept = std::isfinite(h.SclInter) ? h.SclInter : 0.0;
   }
-  const bool integerData = vtkType != VTK_FLOAT && vtkType != VTK_DOUBLE;
-  double range[2];
-  vtkDataArray::GetDataTypeRange(vtkType, range);
-  const double lo = range[0], hi = range[1];
-  const bool integral =
-    integerData && slope == std::floor(slope) && intercept == std::floor(intercept);
-  const double a = slope * lo + intercept, b = slope * hi + intercept;
-  const int type = ChooseScalarType(integral, std::min(a, b), std::max(a, b),
-    vtkType == VTK_DOUBLE || (integerData && (hi - lo) > 16777216.0));
+  const bool integerData = scan.StoredType != VTK_FLOAT && scan.StoredType != VTK_DOUBLE;
+  double stored[2];
+  vtkDataArray::GetDataTypeRange(scan.StoredType, stored);
+  const double a = scan.Slope * stored[0] + scan.Intercept;
+  const double b = scan.Slope * stored[1] + scan.Intercept;
+  SampleRange range;
+  range.Integral = integerData && scan.Slope == std::floor(scan.Slope) &&
+    scan.Intercept == std::floor(scan.Intercept);
+  range.Lo = std::min(a, b);
+  range.Hi = std::max(a, b);
+  range.Wide =
+    scan.StoredType == VTK_DOUBLE || (integerData && (stored[1] - stored[0]) > 16777216.0);
+  return range;
+}
 
-  // Geometry: the voxel-to-world matrix M (RAS) and origin.
-  double m[3][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } }, origin[3] = { 0, 0, 0 };
-  int method = 1;
-  auto columnsOrthogonal = [](const double mm[3][3])
+/// Whether the columns of a 3x3 matrix are non-zero and orthogonal (to 1e-4 of their lengths).
+bool ColumnsOrthogonal(const double matrix[3][3])
+{
+  for (int p = 0; p < 3; ++p)
   {
-    for (int p = 0; p < 3; ++p)
+    for (int q = p + 1; q < 3; ++q)
     {
-      for (int q = p + 1; q < 3; ++q)
+      double dot = 0, np = 0, nq = 0;
+      for (int r = 0; r < 3; ++r)
       {
-        double dot = 0, np = 0, nq = 0;
-        for (int r = 0; r < 3; ++r)
-        {
-          dot += mm[r][p] * mm[r][q];
-          np += mm[r][p] * mm[r][p];
-          nq += mm[r][q] * mm[r][q];
-        }
-        if (np == 0 || nq == 0 || std::fabs(dot) > 1e-4 * std::sqrt(np * nq))
-        {
-          return false;
-        }
+        dot += matrix[r][p] * matrix[r][q];
+        np += matrix[r][p] * matrix[r][p];
+        nq += matrix[r][q] * matrix[r][q];
+      }
+      if (np == 0 || nq == 0 || std::fabs(dot) > 1e-4 * std::sqrt(np * nq))
+      {
+        return false;
       }
     }
-    return true;
-  };
+  }
+  return true;
+}
+
+/// The qform's voxel-to-world matrix (its quaternion's rotation, scaled by pixdim, the third
+/// column flipped when qfac is negative) and its offset.
+void QFormMatrix(const Header& h, const double spacing[3], double matrix[3][3], double origin[3])
+{
+  const double qb = h.Quatern[0], qc = h.Quatern[1], qd = h.Quatern[2];
+  double qa = 1.0 - (qb * qb + qc * qc + qd * qd);
+  qa = qa > 0 ? std::sqrt(qa) : 0.0;
+  const double qfac = h.PixDim[0] < 0 ? -1.0 : 1.0;
+  const double r[3][3] = { { qa * qa + qb * qb - qc * qc - qd * qd, 2 * (qb * qc - qa * qd),
+                             2 * (qb * qd + qa * qc) },
+    { 2 * (qb * qc + qa * qd), qa * qa + qc * qc - qb * qb - qd * qd, 2 * (qc * qd - qa * qb) },
+    { 2 * (qb * qd - qa * qc), 2 * (qc * qd + qa * qb), qa * qa + qd * qd - qc * qc - qb * qb } };
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      matrix[row][c] = r[row][c] * spacing[c] * (c == 2 ? qfac : 1.0);
+    }
+    origin[row] = h.QOffset[row];
+  }
+}
+
+/// PASS 5, first step: the voxel-to-world matrix (RAS) and origin: the sform when sform_code > 0
+/// (a shearing one gives way to a qform), else the qform when qform_code > 0, else pixdim.
+bool VoxelToWorld(VolumeScan& scan, double matrix[3][3], std::string& message)
+{
+  const Header& h = scan.Fields;
   double spacing[3];
   for (int c = 0; c < 3; ++c)
   {
@@ -440,15 +521,15 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
     {
       for (int c = 0; c < 3; ++c)
       {
-        m[r][c] = h.SRow[r][c];
+        matrix[r][c] = h.SRow[r][c];
       }
     }
-    if (!columnsOrthogonal(m))
+    if (!ColumnsOrthogonal(matrix))
     {
       if (h.QFormCode > 0)
       {
-        warnings << path << " has a shearing (or degenerate) sform: its qform places the "
-                 << "volume\n";
+        scan.Warnings << scan.Path << " has a shearing (or degenerate) sform: its qform places "
+                      << "the volume\n";
         useS = false;
       }
       else
@@ -461,91 +542,136 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
   }
   if (useS)
   {
-    method = 3;
+    scan.GeometryMethod = 3;
     for (int r = 0; r < 3; ++r)
     {
-      origin[r] = h.SRow[r][3];
+      scan.Origin[r] = h.SRow[r][3];
     }
   }
   else if (h.QFormCode > 0)
   {
-    method = 2;
-    const double qb = h.Quatern[0], qc = h.Quatern[1], qd = h.Quatern[2];
-    double qa = 1.0 - (qb * qb + qc * qc + qd * qd);
-    qa = qa > 0 ? std::sqrt(qa) : 0.0;
-    const double qfac = h.PixDim[0] < 0 ? -1.0 : 1.0;
-    const double r[3][3] = { { qa * qa + qb * qb - qc * qc - qd * qd, 2 * (qb * qc - qa * qd),
-                               2 * (qb * qd + qa * qc) },
-      { 2 * (qb * qc + qa * qd), qa * qa + qc * qc - qb * qb - qd * qd, 2 * (qc * qd - qa * qb) },
-      { 2 * (qb * qd - qa * qc), 2 * (qc * qd + qa * qb), qa * qa + qd * qd - qc * qc - qb * qb } };
-    for (int row = 0; row < 3; ++row)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        m[row][c] = r[row][c] * spacing[c] * (c == 2 ? qfac : 1.0);
-      }
-      origin[row] = h.QOffset[row];
-    }
+    scan.GeometryMethod = 2;
+    QFormMatrix(h, spacing, matrix, scan.Origin);
   }
   else
   {
     for (int c = 0; c < 3; ++c)
     {
-      m[c][c] = spacing[c];
+      matrix[c][c] = spacing[c];
     }
-    warnings << path << " has neither a qform nor an sform: placed at the origin with its "
-             << "pixdim spacing, axes as stored\n";
+    scan.Warnings << scan.Path << " has neither a qform nor an sform: placed at the origin with "
+                  << "its pixdim spacing, axes as stored\n";
   }
-  double direction[9];
+  return true;
+}
+
+/// PASS 5: geometry. The voxel-to-world matrix's columns, normalized, are the direction matrix
+/// and their lengths the spacing; the world is turned from NIfTI's RAS into DICOM's LPS.
+bool PlaceVolume(VolumeScan& scan, std::string& message)
+{
+  double matrix[3][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } };
+  if (!VoxelToWorld(scan, matrix, message))
+  {
+    return false;
+  }
   for (int c = 0; c < 3; ++c)
   {
-    const double length = std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]);
+    const double length = std::sqrt(
+      matrix[0][c] * matrix[0][c] + matrix[1][c] * matrix[1][c] + matrix[2][c] * matrix[2][c]);
     if (!(length > 0) || !std::isfinite(length))
     {
       message = "has a voxel-to-world matrix with a zero or invalid column " + std::to_string(c);
       return false;
     }
-    spacing[c] = length;
+    scan.Spacing[c] = length;
     for (int r = 0; r < 3; ++r)
     {
-      direction[3 * r + c] = m[r][c] / length;
+      scan.Direction[3 * r + c] = matrix[r][c] / length;
     }
   }
   for (int a = 0; a < 3; ++a)
   {
-    if (!std::isfinite(origin[a]))
+    if (!std::isfinite(scan.Origin[a]))
     {
       message = "has a non-finite origin";
       return false;
     }
   }
-  if (method > 1)
+  if (scan.GeometryMethod > 1)
   {
     // RAS to LPS: negate x and y of every world point.
     for (int c = 0; c < 3; ++c)
     {
-      direction[c] = -direction[c];
-      direction[3 + c] = -direction[3 + c];
+      scan.Direction[c] = -scan.Direction[c];
+      scan.Direction[3 + c] = -scan.Direction[3 + c];
     }
-    origin[0] = -origin[0];
-    origin[1] = -origin[1];
+    scan.Origin[0] = -scan.Origin[0];
+    scan.Origin[1] = -scan.Origin[1];
   }
+  return true;
+}
 
+/// The scan in words, for the log: the size, the geometry's source, the spacing, the scaling.
+std::string Summarize(const VolumeScan& scan)
+{
+  const int* dims = scan.Dimensions;
   std::ostringstream summary;
-  summary << "NIfTI-1 " << (compressed ? "(gzip) " : "") << dims[0] << " x " << dims[1] << " x "
-          << dims[2] << ", "
-          << (method == 3      ? "sform"
-                 : method == 2 ? "qform"
-                               : "pixdim")
-          << " geometry, spacing " << Describe(spacing[0]) << " x " << Describe(spacing[1]) << " x "
-          << Describe(spacing[2]) << " mm, scaling " << Describe(slope) << " * stored + "
-          << Describe(intercept);
+  summary << "NIfTI-1 " << (scan.Compressed ? "(gzip) " : "") << dims[0] << " x " << dims[1]
+          << " x " << dims[2] << ", "
+          << (scan.GeometryMethod == 3      ? "sform"
+                 : scan.GeometryMethod == 2 ? "qform"
+                                            : "pixdim")
+          << " geometry, spacing " << Describe(scan.Spacing[0]) << " x "
+          << Describe(scan.Spacing[1]) << " x " << Describe(scan.Spacing[2]) << " mm, scaling "
+          << Describe(scan.Slope) << " * stored + " << Describe(scan.Intercept);
+  return summary.str();
+}
 
+} // namespace
+
+//------------------------------------------------------------------------------
+// Rank 0 alone runs the scan, and it makes no collective call: vtkRGVolumeReader's
+// RequestInformation agrees on its status over all ranks, then broadcasts the header it writes.
+//
+//  PASS 1 ReadHeader      the 348-byte header, either byte order, compressed or not
+//  PASS 2 ReadDimensions  x, y, z (the first volume of a 4-D file)
+//  PASS 3 CheckVoxelData  the datatype, where the voxels start, a truncated .nii
+//  PASS 4 ReadScaling     scl_slope and scl_inter, and the output type they give
+//  PASS 5 PlaceVolume     sform, else qform, else pixdim; RAS turned into LPS
+bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
+{
+  VolumeScan scan;
+  scan.Path = this->FileName;
+  // PASS 1: the header.
+  if (!ReadHeader(scan, message))
+  {
+    return false;
+  }
+  // PASS 2: dimensions; a fourth and later dimension beyond 1 gives the first volume.
+  if (!ReadDimensions(scan, message))
+  {
+    return false;
+  }
+  // PASS 3: the stored voxels.
+  if (!CheckVoxelData(scan, message))
+  {
+    return false;
+  }
+  // PASS 4: scaling and the output type.
+  const SampleRange range = ReadScaling(scan);
+  const int type = ChooseScalarType(range.Integral, range.Lo, range.Hi, range.Wide);
+  // PASS 5: geometry, in DICOM's patient coordinates.
+  if (!PlaceVolume(scan, message))
+  {
+    return false;
+  }
+  // The header every rank parses, in the order Parse reads it.
   rgmc::Packer p;
-  PackGeometry(p, dims, spacing, origin, direction, type);
-  p.Number(vtkType).Number(bytes).Number(h.Swap ? 1 : 0).Number(h.VoxOffset);
-  p.Number(slope).Number(intercept).Number(method);
-  p.String(warnings.str()).String(summary.str());
+  PackGeometry(p, scan.Dimensions, scan.Spacing, scan.Origin, scan.Direction, type);
+  p.Number(scan.StoredType).Number(scan.BytesPerVoxel).Number(scan.Fields.Swap ? 1 : 0);
+  p.Number(scan.Fields.VoxOffset);
+  p.Number(scan.Slope).Number(scan.Intercept).Number(scan.GeometryMethod);
+  p.String(scan.Warnings.str()).String(Summarize(scan));
   header = p.Text;
   return true;
 }
