@@ -458,18 +458,14 @@ bool Resolve(Ranks& ranks, rgmc::Keep mode, const rgmc::ComponentGraph& graph,
   }
   ranks.GatherV(graph.Part.data(), parts.data(), gatherLengths[ranks.Rank], gatherLengths.data(),
     gatherOffsets.data(), 0, "gathering the components");
-  if (ranks.Rank == 0)
+  std::string noMemory; // on rank 0, told to every rank below
+  if (ranks.Rank == 0 &&
+    !rgmc::TryLocally(noMemory, "decide which components to keep",
+      [&]() { rgmc::Decide(mode, parts, roots, edges, decided.data()); }))
   {
-    try
+    for (int r = 0; r < size; ++r)
     {
-      rgmc::Decide(mode, parts, roots, edges, decided.data());
-    }
-    catch (const std::bad_alloc&)
-    {
-      for (int r = 0; r < size; ++r)
-      {
-        decided[scatterOffsets[r]] = 1; // the verdict every rank reads
-      }
+      decided[scatterOffsets[r]] = 1; // the verdict every rank reads
     }
   }
   ranks.ScatterV(decided.data(), mine.data(), scatterLengths.data(), scatterOffsets.data(),
@@ -1056,38 +1052,31 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
     }
   }
   std::string outOfMemory;
-  try
-  {
-    if (!rounds && this->ExtractionMode == SEEDED)
+  rgmc::TryLocally(
+    outOfMemory, "grow and extract the surface", ranks.Rank,
+    [&]()
     {
-      for (vtkIdType key : run.seedKeys)
+      if (!rounds && this->ExtractionMode == SEEDED)
       {
-        kernel.GrowFromKey(key);
+        for (vtkIdType key : run.seedKeys)
+        {
+          kernel.GrowFromKey(key);
+        }
       }
-    }
-    else if (!rounds)
-    {
-      run.oneStep = true;
-      kernel.GrowAll();
-    }
-    if (!aborted)
-    {
-      kernel.Extract();
-      run.trianglesMade = kernel.Mesh().NumberOfTriangles();
-      run.graph.Prepare(kernel, *run.grid, *run.own, ranks.Rank, ranks.Size);
-    }
-  }
-  catch (const std::length_error& tooMany)
-  {
-    outOfMemory = std::string(tooMany.what()) + " on rank " + std::to_string(ranks.Rank) +
-      ": run on more ranks";
-  }
-  catch (const std::bad_alloc&)
-  {
-    outOfMemory = "not enough memory to grow and extract the surface on rank " +
-      std::to_string(ranks.Rank) + " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) +
-      " triangles so far)";
-  }
+      else if (!rounds)
+      {
+        run.oneStep = true;
+        kernel.GrowAll();
+      }
+      if (!aborted)
+      {
+        kernel.Extract();
+        run.trianglesMade = kernel.Mesh().NumberOfTriangles();
+        run.graph.Prepare(kernel, *run.grid, *run.own, ranks.Rank, ranks.Size);
+      }
+    },
+    [&]()
+    { return " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) + " triangles so far)"; });
   run.problem = outOfMemory.empty() ? kernel.Error() : outOfMemory;
   aborted = aborted || kernel.Aborted();
   // Ports go to the neighbours that own the other cubes around them (nothing after a failure
@@ -1099,15 +1088,8 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
     sendPorts ? run.graph.PortsTo : nothing, run.own->MeetingOrder(), PortTag);
   if (sendPorts)
   {
-    try
-    {
-      run.graph.Join(incoming, ranks.Rank);
-    }
-    catch (const std::bad_alloc&)
-    {
-      run.problem =
-        "not enough memory to join the components on rank " + std::to_string(ranks.Rank);
-    }
+    rgmc::TryLocally(run.problem, "join the components", ranks.Rank,
+      [&]() { run.graph.Join(incoming, ranks.Rank); });
   }
   // One agreement, which also tells every rank the sizes of every rank's part of the graph.
   std::vector<vtkIdType> mine = { run.graph.Roots, run.graph.Edges, aborted ? 1 : 0,
@@ -1157,26 +1139,7 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
   const rgmc::Ownership& own = *run.own;
   std::string problem;
   auto local = [&](const char* what, const std::function<void()>& work)
-  {
-    if (!problem.empty())
-    {
-      return;
-    }
-    try
-    {
-      work();
-    }
-    catch (const std::length_error& tooMany)
-    {
-      problem = std::string(tooMany.what()) + " on rank " + std::to_string(ranks.Rank) +
-        ": run on more ranks";
-    }
-    catch (const std::bad_alloc&)
-    {
-      problem =
-        std::string("not enough memory to ") + what + " on rank " + std::to_string(ranks.Rank);
-    }
-  };
+  { rgmc::TryLocally(problem, what, ranks.Rank, work); };
   kernel.SetCrossRanks(true);
   kernel.SetBudget(GrowthBudget);
   local("grow from the seeds",
