@@ -7,6 +7,8 @@
 #include "rgmcSurfaceKernel.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
+#include "vtkRGCompatibility.h"
+#include "vtkRGRunController.h"
 #include "vtkRGThreads.h"
 
 #include "vtkArrayDispatch.h"
@@ -16,7 +18,6 @@
 #include "vtkDataArrayRange.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
-#include "vtkDummyController.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIdTypeArray.h"
@@ -626,12 +627,9 @@ int vtkRGMarchingCubes::RequestData(
 {
   vtkImageData* input = vtkImageData::GetData(inputVector[0]);
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
-  // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
-  // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
-  // SetAbortExecute would mark the filter modified and make it run again.
-  this->AbortExecute = 0;
-  vtkNew<vtkDummyController> single;
-  Run run(this->Controller ? this->Controller : single.Get());
+  rgmc::ForgetEarlierAbort(this->AbortExecute);
+  rgmc::RunController controller(this->Controller);
+  Run run(controller);
   // The counts of this run, however it ends.
   struct Accounting
   {
