@@ -4,6 +4,8 @@
 #ifndef vtkRGCollective_h
 #define vtkRGCollective_h
 
+#include "vtkRGOutOfMemory.h"
+
 #include "vtkCommunicator.h"
 #include "vtkMultiProcessController.h"
 #include "vtkType.h"
@@ -71,25 +73,12 @@ public:
   }
 
   /// Runs `work` (local work, no communication) unless `problem` is already set; an allocation
-  /// failure becomes the problem "not enough memory to <what>". Then agrees, as Agree does.
+  /// failure becomes the problem "not enough memory to <what>" (TryLocally). Then agrees, as
+  /// Agree does.
   template <typename Work>
   bool Step(const char* what, std::string& problem, Work&& work)
   {
-    if (problem.empty())
-    {
-      try
-      {
-        work();
-      }
-      catch (const std::bad_alloc&)
-      {
-        problem = std::string("not enough memory to ") + what;
-      }
-      catch (const std::length_error&)
-      {
-        problem = std::string("not enough memory to ") + what;
-      }
-    }
+    TryLocally(problem, what, std::forward<Work>(work));
     return this->Agree(problem.empty(), problem);
   }
 

@@ -3,9 +3,12 @@
 #include "vtkRGMarchingCubes.h"
 
 #include "rgmcCaseTable.h"
+#include "rgmcComponentGraph.h"
 #include "rgmcSurfaceKernel.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
+#include "vtkRGCompatibility.h"
+#include "vtkRGRunController.h"
 #include "vtkRGThreads.h"
 
 #include "vtkArrayDispatch.h"
@@ -15,7 +18,6 @@
 #include "vtkDataArrayRange.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
-#include "vtkDummyController.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIdTypeArray.h"
@@ -375,29 +377,12 @@ void ForOtherOwners(
 
 // ---- the global decision: which components to keep, and their ids --------------------------
 
-struct Decision
+/// This rank's part of the component graph (rgmc::ComponentGraph), made after extraction, with
+/// what routes it: the root of each local component, and the ports to send to each neighbour.
+struct RankGraph : rgmc::ComponentGraph
 {
-  std::vector<vtkIdType> FinalId; // per local root component (rootIndex order), -1 = dropped
-  vtkIdType Triangles = 0;
-  vtkIdType Components = 0;
-};
-
-/// A component of some rank in one number: the rank and its root's index there.
-vtkIdType RankComponent(int rank, vtkIdType root)
-{
-  return (static_cast<vtkIdType>(rank) << 32) | root;
-}
-
-/// This rank's part of the component graph, made after extraction: its root components (their
-/// totals, which rank 0 needs) and the ports that join them to other ranks' components.
-struct ComponentGraph
-{
-  std::vector<int> RootIndex;                            // per local component: its root's index
-  std::vector<vtkIdType> Part;                           // 3 values per root, then 2 per edge
-  std::vector<std::vector<vtkIdType>> PortsTo;           // per rank: (key, root index) pairs
-  std::vector<std::pair<std::int64_t, vtkIdType>> Ports; // (key, root index), sorted
-  vtkIdType Roots = 0;
-  vtkIdType Edges = 0;
+  std::vector<int> RootIndex;                  // per local component: its root's index
+  std::vector<std::vector<vtkIdType>> PortsTo; // per rank: (key, root index) pairs
 
   /// Numbers the roots, lists their totals, and sorts the ports by the ranks that own the other
   /// cubes around them. Local work.
@@ -411,10 +396,8 @@ struct ComponentGraph
       if (comps.Root(c) == c)
       {
         const rgmc::ComponentSet::Totals& totals = comps.TotalsOf(c);
-        this->RootIndex[c] = static_cast<int>(this->Roots++);
-        this->Part.push_back(totals.Triangles);
-        this->Part.push_back(totals.MinKey);
-        this->Part.push_back(totals.Seeded ? 1 : 0);
+        this->RootIndex[c] =
+          static_cast<int>(this->AddRoot(totals.Triangles, totals.MinKey, totals.Seeded));
       }
     }
     for (int c = 0; c < comps.Size(); ++c)
@@ -435,136 +418,23 @@ struct ComponentGraph
     }
     std::sort(this->Ports.begin(), this->Ports.end());
   }
-
-  /// Appends the edges between this rank's components and the neighbours' that share a port
-  /// (each once), as pairs of RankComponent numbers.
-  void Join(const std::vector<std::vector<vtkIdType>>& incoming, int rank)
-  {
-    std::vector<std::pair<vtkIdType, vtkIdType>> edges;
-    for (int from = 0; from < static_cast<int>(incoming.size()); ++from)
-    {
-      const std::vector<vtkIdType>& list = incoming[from];
-      for (std::size_t n = 0; from != rank && n + 1 < list.size(); n += 2)
-      {
-        auto it = std::lower_bound(this->Ports.begin(), this->Ports.end(),
-          std::make_pair(
-            static_cast<std::int64_t>(list[n]), std::numeric_limits<vtkIdType>::min()));
-        if (it != this->Ports.end() && it->first == list[n])
-        {
-          const vtkIdType mine = RankComponent(rank, it->second);
-          const vtkIdType theirs = RankComponent(from, list[n + 1]);
-          edges.emplace_back(std::min(mine, theirs), std::max(mine, theirs));
-        }
-      }
-    }
-    std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    for (const auto& e : edges)
-    {
-      this->Part.push_back(e.first);
-      this->Part.push_back(e.second);
-    }
-    this->Edges = static_cast<vtkIdType>(edges.size());
-  }
 };
 
-/// On rank 0: joins the components of all ranks (`parts`, rank after rank, of `roots[r]`
-/// roots and `edges[r]` edges each) and decides which to keep. Writes, for each rank r at
-/// `out + offset[r]`, its header (0, the kept triangles, the kept components) and the final id
-/// of each of its roots (-1: dropped).
-void Decide(int mode, const std::vector<vtkIdType>& parts, const std::vector<vtkIdType>& roots,
-  const std::vector<vtkIdType>& edges, const std::vector<vtkIdType>& scatterOffsets, vtkIdType* out)
+/// The filter's ExtractionMode in the kernel's words.
+rgmc::Keep Kept(int mode)
 {
-  const int numRanks = static_cast<int>(roots.size());
-  std::vector<vtkIdType> first(numRanks + 1, 0); // dense number of each rank's first root
-  for (int r = 0; r < numRanks; ++r)
-  {
-    first[r + 1] = first[r] + roots[r];
-  }
-  const vtkIdType total = first[numRanks];
-  rgmc::UnionFind<vtkIdType> sets;
-  sets.Reset(static_cast<std::size_t>(total));
-  struct Class
-  {
-    vtkIdType Triangles = 0;
-    vtkIdType MinKey = std::numeric_limits<vtkIdType>::max();
-    bool Seeded = false;
-  };
-  std::vector<Class> classes(static_cast<std::size_t>(total));
-  const vtkIdType* at = parts.data();
-  std::vector<std::array<vtkIdType, 3>> info(static_cast<std::size_t>(total));
-  for (int r = 0; r < numRanks; ++r)
-  {
-    for (vtkIdType c = 0; c < roots[r]; ++c, at += 3)
-    {
-      info[first[r] + c] = { at[0], at[1], at[2] };
-    }
-    for (vtkIdType e = 0; e < edges[r]; ++e, at += 2)
-    {
-      auto dense = [&first](vtkIdType rc) { return first[rc >> 32] + (rc & 0xffffffff); };
-      sets.Unite(dense(at[0]), dense(at[1]));
-    }
-  }
-  for (vtkIdType c = 0; c < total; ++c)
-  {
-    Class& k = classes[sets.Find(c)];
-    k.Triangles += info[c][0];
-    k.MinKey = std::min(k.MinKey, info[c][1]);
-    k.Seeded = k.Seeded || info[c][2] != 0;
-  }
-  std::vector<vtkIdType> selected;
-  vtkIdType largest = -1;
-  for (vtkIdType c = 0; c < total; ++c)
-  {
-    if (sets.Find(c) != c || classes[c].Triangles == 0)
-    {
-      continue;
-    }
-    if (mode == vtkRGMarchingCubes::ALL_COMPONENTS ||
-      (mode == vtkRGMarchingCubes::SEEDED && classes[c].Seeded))
-    {
-      selected.push_back(c);
-    }
-    if (largest < 0 || classes[c].Triangles > classes[largest].Triangles ||
-      (classes[c].Triangles == classes[largest].Triangles &&
-        classes[c].MinKey < classes[largest].MinKey))
-    {
-      largest = c;
-    }
-  }
-  if (mode == vtkRGMarchingCubes::LARGEST_COMPONENT && largest >= 0)
-  {
-    selected.push_back(largest);
-  }
-  std::sort(selected.begin(), selected.end(),
-    [&classes](vtkIdType a, vtkIdType b) { return classes[a].MinKey < classes[b].MinKey; });
-  std::vector<vtkIdType> idOfClass(static_cast<std::size_t>(total), -1);
-  vtkIdType triangles = 0;
-  for (std::size_t n = 0; n < selected.size(); ++n)
-  {
-    idOfClass[selected[n]] = static_cast<vtkIdType>(n);
-    triangles += classes[selected[n]].Triangles;
-  }
-  for (int r = 0; r < numRanks; ++r)
-  {
-    vtkIdType* header = out + scatterOffsets[r];
-    header[0] = 0;
-    header[1] = triangles;
-    header[2] = static_cast<vtkIdType>(selected.size());
-    for (vtkIdType c = 0; c < roots[r]; ++c)
-    {
-      header[3 + c] = idOfClass[sets.Find(first[r] + c)];
-    }
-  }
+  return mode == vtkRGMarchingCubes::SEEDED         ? rgmc::Keep::Seeded
+    : mode == vtkRGMarchingCubes::LARGEST_COMPONENT ? rgmc::Keep::Largest
+                                                    : rgmc::Keep::All;
 }
 
 /// Gathers the component graph (each rank's part, sizes known to all from `roots` and
 /// `edges`) on rank 0, which decides, and gives each rank its decision. Collective; false (with
 /// `problem`) when it failed, on every rank alike (rank 0's verdict comes with the decision),
 /// but not yet agreed: the caller's next agreement does that.
-bool Resolve(Ranks& ranks, int mode, const ComponentGraph& graph,
-  const std::vector<vtkIdType>& roots, const std::vector<vtkIdType>& edges, Decision& decision,
-  std::string& problem)
+bool Resolve(Ranks& ranks, rgmc::Keep mode, const rgmc::ComponentGraph& graph,
+  const std::vector<std::int64_t>& roots, const std::vector<std::int64_t>& edges,
+  rgmc::Decision& decision, std::string& problem)
 {
   const int size = ranks.Size;
   std::vector<vtkIdType> gatherLengths(size), gatherOffsets(size + 1, 0);
@@ -576,7 +446,7 @@ bool Resolve(Ranks& ranks, int mode, const ComponentGraph& graph,
     scatterLengths[r] = 3 + roots[r]; // the header, then the roots' final ids
     scatterOffsets[r + 1] = scatterOffsets[r] + scatterLengths[r];
   }
-  std::vector<vtkIdType> parts, decided, mine;
+  std::vector<std::int64_t> parts, decided, mine;
   if (!ranks.Step("join the components", problem,
         [&]()
         {
@@ -589,18 +459,14 @@ bool Resolve(Ranks& ranks, int mode, const ComponentGraph& graph,
   }
   ranks.GatherV(graph.Part.data(), parts.data(), gatherLengths[ranks.Rank], gatherLengths.data(),
     gatherOffsets.data(), 0, "gathering the components");
-  if (ranks.Rank == 0)
+  std::string noMemory; // on rank 0, told to every rank below
+  if (ranks.Rank == 0 &&
+    !rgmc::TryLocally(noMemory, "decide which components to keep",
+      [&]() { rgmc::Decide(mode, parts, roots, edges, decided.data()); }))
   {
-    try
+    for (int r = 0; r < size; ++r)
     {
-      Decide(mode, parts, roots, edges, scatterOffsets, decided.data());
-    }
-    catch (const std::bad_alloc&)
-    {
-      for (int r = 0; r < size; ++r)
-      {
-        decided[scatterOffsets[r]] = 1; // the verdict every rank reads
-      }
+      decided[scatterOffsets[r]] = 1; // the verdict every rank reads
     }
   }
   ranks.ScatterV(decided.data(), mine.data(), scatterLengths.data(), scatterOffsets.data(),
@@ -727,9 +593,9 @@ struct vtkRGMarchingCubes::Run
   std::vector<rgmc::CellBox> extentBoxes; // per rank: all the cells of its extent
   std::vector<vtkIdType> seedKeys;
   std::vector<double> seedPoints;
-  ComponentGraph graph;
-  std::vector<vtkIdType> roots, edges; // per rank: the sizes of its part of the graph
-  Decision decision;
+  RankGraph graph;
+  std::vector<std::int64_t> roots, edges; // per rank: the sizes of its part of the graph
+  rgmc::Decision decision;
   int rounds = 0;       // rounds of growth between ranks
   bool oneStep = false; // the rest grown in one step (GrowBoundary) or a full scan
   vtkIdType trianglesMade = 0;
@@ -761,12 +627,9 @@ int vtkRGMarchingCubes::RequestData(
 {
   vtkImageData* input = vtkImageData::GetData(inputVector[0]);
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
-  // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
-  // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
-  // SetAbortExecute would mark the filter modified and make it run again.
-  this->AbortExecute = 0;
-  vtkNew<vtkDummyController> single;
-  Run run(this->Controller ? this->Controller : single.Get());
+  rgmc::ForgetEarlierAbort(this->AbortExecute);
+  rgmc::RunController controller(this->Controller);
+  Run run(controller);
   // The counts of this run, however it ends.
   struct Accounting
   {
@@ -803,8 +666,8 @@ int vtkRGMarchingCubes::RequestData(
   }
   this->UpdateProgress(0.8);
   // PASS 4: join components across ranks; decide what to keep (agreed in pass 5).
-  Resolve(
-    run.ranks, this->ExtractionMode, run.graph, run.roots, run.edges, run.decision, run.problem);
+  Resolve(run.ranks, Kept(this->ExtractionMode), run.graph, run.roots, run.edges, run.decision,
+    run.problem);
   this->UpdateProgress(0.9);
   // PASS 5: the output piece.
   if (!this->StoreSurface(run, output))
@@ -1187,38 +1050,31 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
     }
   }
   std::string outOfMemory;
-  try
-  {
-    if (!rounds && this->ExtractionMode == SEEDED)
+  rgmc::TryLocally(
+    outOfMemory, "grow and extract the surface", ranks.Rank,
+    [&]()
     {
-      for (vtkIdType key : run.seedKeys)
+      if (!rounds && this->ExtractionMode == SEEDED)
       {
-        kernel.GrowFromKey(key);
+        for (vtkIdType key : run.seedKeys)
+        {
+          kernel.GrowFromKey(key);
+        }
       }
-    }
-    else if (!rounds)
-    {
-      run.oneStep = true;
-      kernel.GrowAll();
-    }
-    if (!aborted)
-    {
-      kernel.Extract();
-      run.trianglesMade = kernel.Mesh().NumberOfTriangles();
-      run.graph.Prepare(kernel, *run.grid, *run.own, ranks.Rank, ranks.Size);
-    }
-  }
-  catch (const std::length_error& tooMany)
-  {
-    outOfMemory = std::string(tooMany.what()) + " on rank " + std::to_string(ranks.Rank) +
-      ": run on more ranks";
-  }
-  catch (const std::bad_alloc&)
-  {
-    outOfMemory = "not enough memory to grow and extract the surface on rank " +
-      std::to_string(ranks.Rank) + " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) +
-      " triangles so far)";
-  }
+      else if (!rounds)
+      {
+        run.oneStep = true;
+        kernel.GrowAll();
+      }
+      if (!aborted)
+      {
+        kernel.Extract();
+        run.trianglesMade = kernel.Mesh().NumberOfTriangles();
+        run.graph.Prepare(kernel, *run.grid, *run.own, ranks.Rank, ranks.Size);
+      }
+    },
+    [&]()
+    { return " (" + std::to_string(kernel.Mesh().NumberOfTriangles()) + " triangles so far)"; });
   run.problem = outOfMemory.empty() ? kernel.Error() : outOfMemory;
   aborted = aborted || kernel.Aborted();
   // Ports go to the neighbours that own the other cubes around them (nothing after a failure
@@ -1230,15 +1086,8 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
     sendPorts ? run.graph.PortsTo : nothing, run.own->MeetingOrder(), PortTag);
   if (sendPorts)
   {
-    try
-    {
-      run.graph.Join(incoming, ranks.Rank);
-    }
-    catch (const std::bad_alloc&)
-    {
-      run.problem =
-        "not enough memory to join the components on rank " + std::to_string(ranks.Rank);
-    }
+    rgmc::TryLocally(run.problem, "join the components", ranks.Rank,
+      [&]() { run.graph.Join(incoming, ranks.Rank); });
   }
   // One agreement, which also tells every rank the sizes of every rank's part of the graph.
   std::vector<vtkIdType> mine = { run.graph.Roots, run.graph.Edges, aborted ? 1 : 0,
@@ -1288,26 +1137,7 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
   const rgmc::Ownership& own = *run.own;
   std::string problem;
   auto local = [&](const char* what, const std::function<void()>& work)
-  {
-    if (!problem.empty())
-    {
-      return;
-    }
-    try
-    {
-      work();
-    }
-    catch (const std::length_error& tooMany)
-    {
-      problem = std::string(tooMany.what()) + " on rank " + std::to_string(ranks.Rank) +
-        ": run on more ranks";
-    }
-    catch (const std::bad_alloc&)
-    {
-      problem =
-        std::string("not enough memory to ") + what + " on rank " + std::to_string(ranks.Rank);
-    }
-  };
+  { rgmc::TryLocally(problem, what, ranks.Rank, work); };
   kernel.SetCrossRanks(true);
   kernel.SetBudget(GrowthBudget);
   local("grow from the seeds",
@@ -1427,7 +1257,7 @@ bool vtkRGMarchingCubes::StoreSurface(Run& run, vtkPolyData* output)
   return run.ranks.Step("store the surface", run.problem,
     [&]()
     {
-      const Decision& decision = run.decision;
+      const rgmc::Decision& decision = run.decision;
       const std::vector<int>& rootIndex = run.graph.RootIndex;
       rgmc::LocalMesh& mesh = run.kernel->Mesh();
       mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });

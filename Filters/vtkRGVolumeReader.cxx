@@ -4,10 +4,10 @@
 
 #include "vtkRGCollective.h"
 #include "vtkRGPacking.h"
+#include "vtkRGRunController.h"
 
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
-#include "vtkDummyController.h"
 #include "vtkExtentTranslator.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -85,8 +85,8 @@ void vtkRGVolumeReader::Store(
 int vtkRGVolumeReader::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkNew<vtkDummyController> single;
-  rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
+  rgmc::RunController controller(this->Controller);
+  rgmc::Ranks ranks(controller);
 
   // PASS 1: the header scan, on rank 0, only when a property changed since the last one. Every
   // rank takes the same branch: they all saw the same property changes.
@@ -201,8 +201,8 @@ bool vtkRGVolumeReader::PieceExtent(vtkInformation* outInfo, int extent[6], int 
 int vtkRGVolumeReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkNew<vtkDummyController> single;
-  rgmc::Ranks ranks(this->Controller ? this->Controller : single.Get());
+  rgmc::RunController controller(this->Controller);
+  rgmc::Ranks ranks(controller);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkImageData* output = vtkImageData::GetData(outInfo);
 
