@@ -1049,7 +1049,8 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
       return -1;
     }
   }
-  std::string outOfMemory;
+  // A failure of the last round's growth (GrowInRounds) skips the extraction.
+  std::string outOfMemory = run.problem;
   rgmc::TryLocally(
     outOfMemory, "grow and extract the surface", ranks.Rank,
     [&]()
@@ -1218,7 +1219,8 @@ bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
           kernel.Continue();
           kernel.GrowBoundary();
         });
-      return true; // GrowAndExtract agrees on the status
+      run.problem = problem; // GrowAndExtract agrees on the status
+      return true;
     }
     const std::vector<std::vector<vtkIdType>> incoming =
       ranks.ExchangeInOrder(outgoing, own.MeetingOrder(), DepartureTag);

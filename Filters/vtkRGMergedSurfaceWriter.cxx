@@ -3,13 +3,13 @@
 #include "vtkRGMergedSurfaceWriter.h"
 
 #include "vtkRGCollective.h"
+#include "vtkRGRunController.h"
 #include "vtkRGSeamRepair.h"
 
 #include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"
 #include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
-#include "vtkDummyController.h"
 #include "vtkFieldData.h"
 #include "vtkIdList.h"
 #include "vtkIdTypeArray.h"
@@ -820,8 +820,8 @@ struct vtkRGMergedSurfaceWriter::Run
 //  PASS 4                 agreement (every rank opened it), agreement (every rank wrote)
 void vtkRGMergedSurfaceWriter::WriteData()
 {
-  vtkNew<vtkDummyController> single;
-  Run run(this->Controller ? this->Controller : single.Get());
+  rgmc::RunController controller(this->Controller);
+  Run run(controller);
   // PASS 1: the file name and the format, agreed.
   if (!this->AgreeOnFile(run))
   {

@@ -7,7 +7,9 @@
 #include "rgmcSmoothing.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
+#include "vtkRGCompatibility.h"
 #include "vtkRGMessage.h"
+#include "vtkRGRunController.h"
 #include "vtkRGThreads.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -15,7 +17,6 @@
 #include "vtkCellData.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
-#include "vtkDummyController.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIdTypeArray.h"
@@ -1542,12 +1543,9 @@ int vtkRGSeamRepair::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
-  // A new run: an abort of an earlier run does not carry over (VTK 9.2 cleared the flag itself;
-  // VTK 9.3 and later keep it, so an aborted filter would stay empty). Set directly, as
-  // SetAbortExecute would mark the filter modified and make it run again.
-  this->AbortExecute = 0;
-  vtkNew<vtkDummyController> single;
-  Run run(this->Controller ? this->Controller : single.Get(), vtkPolyData::GetData(inputVector[0]));
+  rgmc::ForgetEarlierAbort(this->AbortExecute);
+  rgmc::RunController controller(this->Controller);
+  Run run(controller, vtkPolyData::GetData(inputVector[0]));
   // The count of this run's collective calls, however it ends.
   struct Accounting
   {
