@@ -105,17 +105,17 @@ bool Ranks::Any(bool flag)
   return any != 0;
 }
 
-void Ranks::Broadcast(std::string& text, int root)
+void Ranks::Broadcast(std::vector<vtkIdType>& words, int root)
 {
-  vtkIdType length = static_cast<vtkIdType>(text.size());
+  vtkIdType length = static_cast<vtkIdType>(words.size());
   this->BroadcastValues(&length, 1, root, "a broadcast");
   if (this->Rank != root)
   {
-    text.assign(static_cast<std::size_t>(length), '\0');
+    words.assign(static_cast<std::size_t>(length), 0);
   }
   if (length > 0)
   {
-    this->BroadcastValues(&text[0], length, root, "a broadcast");
+    this->BroadcastValues(words.data(), length, root, "a broadcast");
   }
 }
 

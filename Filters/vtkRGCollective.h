@@ -89,8 +89,8 @@ public:
   /// Whether `flag` holds on some rank.
   bool Any(bool flag);
 
-  /// Gives every rank the `text` of rank `root`.
-  void Broadcast(std::string& text, int root);
+  /// Gives every rank the `words` of rank `root` (a message, see vtkRGMessage.h).
+  void Broadcast(std::vector<vtkIdType>& words, int root);
 
   /// Sends outgoing[r] to every rank r marked in `partners` (a symmetric relation) and returns
   /// what each sent back. Rounds follow a round-robin tournament, so every round is a perfect

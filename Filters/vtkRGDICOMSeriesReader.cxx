@@ -2,7 +2,7 @@
 // grouping, sorting and checking; then each rank decodes the files of its own slab with GDCM.
 #include "vtkRGDICOMSeriesReader.h"
 
-#include "vtkRGPacking.h"
+#include "vtkRGMessage.h"
 
 #include "rgmcDicomStructure.h"
 
@@ -1204,20 +1204,20 @@ std::string Summarize(const SeriesScan& scan)
 
 /// What follows the geometry in the header, in the order Parse reads it: the pixel description,
 /// the scan's words and every slice.
-void PackSeries(rgmc::Packer& p, const SeriesScan& scan)
+void PackSeries(rgmc::MessageWriter& p, const SeriesScan& scan)
 {
   const FileHeader& first = scan.Files.front();
-  p.Number(first.Samples).Number(first.Planar).Number(first.BitsAllocated);
-  p.Number(first.BitsStored).Number(first.PixelRepresentation).Number(first.TransferSyntax);
-  p.Number(scan.Deviation).Number(static_cast<double>(scan.Files.size()));
-  p.String(first.Modality == "CT" ? "HU" : "Intensity")
-    .String(scan.SeriesList)
-    .String(scan.Warnings.str());
-  p.String(Summarize(scan)).String(first.Photometric);
-  p.Number(first.Encapsulated ? 1 : 0).Number(first.Frames);
+  p.Int(first.Samples).Int(first.Planar).Int(first.BitsAllocated);
+  p.Int(first.BitsStored).Int(first.PixelRepresentation).Int(first.TransferSyntax);
+  p.Real(scan.Deviation).Int(static_cast<std::int64_t>(scan.Files.size()));
+  p.Text(first.Modality == "CT" ? "HU" : "Intensity")
+    .Text(scan.SeriesList)
+    .Text(scan.Warnings.str());
+  p.Text(Summarize(scan)).Text(first.Photometric);
+  p.Int(first.Encapsulated ? 1 : 0).Int(first.Frames);
   for (const Slice& s : scan.Slices)
   {
-    p.String(s.Path).Number(s.Frame).Number(s.Slope).Number(s.Intercept);
+    p.Text(s.Path).Int(s.Frame).Real(s.Slope).Real(s.Intercept);
   }
 }
 
@@ -1233,7 +1233,7 @@ void PackSeries(rgmc::Packer& p, const SeriesScan& scan)
 //  PASS 4 CheckSeries   one size, pixel format, orientation and pixel spacing for all
 //  PASS 5 PlaceSlices   the axes, the slices sorted along the normal, their spacing, the origin
 //  PASS 6               the output type; the header: geometry, pixel description, slices
-bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
+bool vtkRGDICOMSeriesReader::Scan(std::vector<vtkIdType>& header, std::string& message)
 {
   SeriesScan scan;
   scan.Name = this->FileName;
@@ -1266,45 +1266,45 @@ bool vtkRGDICOMSeriesReader::Scan(std::string& header, std::string& message)
   const int type = first.Samples == 3
     ? ColourScalarType(first.BitsAllocated)
     : ChooseScalarType(range.Integral, range.Lo, range.Hi, range.Wide);
-  rgmc::Packer p;
+  header.clear();
+  rgmc::MessageWriter p(header);
   PackGeometry(p, scan.Dimensions, scan.Spacing, scan.Origin, scan.Direction, type);
   PackSeries(p, scan);
-  header = p.Text;
   return true;
 }
 
 //------------------------------------------------------------------------------
-bool vtkRGDICOMSeriesReader::Parse(const std::string& header, std::string& message)
+bool vtkRGDICOMSeriesReader::Parse(const std::vector<vtkIdType>& header, std::string& message)
 {
-  rgmc::Unpacker u(header);
+  rgmc::MessageReader u(header);
   Internals& in = *this->Internal;
   PixelDescription& pixels = in.Pixels;
   this->UnpackGeometry(u);
-  pixels.Samples = u.Int();
-  pixels.Planar = u.Int();
-  pixels.BitsAllocated = u.Int();
-  pixels.BitsStored = u.Int();
-  pixels.PixelRepresentation = u.Int();
-  pixels.TransferSyntax = u.Int();
-  this->LargestSpacingDeviation = u.Number();
-  in.Files = static_cast<std::size_t>(u.Number());
-  this->ArrayName = u.String();
-  this->SeriesList = u.String();
-  this->Warnings = u.String();
-  this->Summary = u.String();
-  pixels.Photometric = u.String();
+  pixels.Samples = static_cast<int>(u.Int());
+  pixels.Planar = static_cast<int>(u.Int());
+  pixels.BitsAllocated = static_cast<int>(u.Int());
+  pixels.BitsStored = static_cast<int>(u.Int());
+  pixels.PixelRepresentation = static_cast<int>(u.Int());
+  pixels.TransferSyntax = static_cast<int>(u.Int());
+  this->LargestSpacingDeviation = u.Real();
+  in.Files = static_cast<std::size_t>(u.Int());
+  this->ArrayName = u.Text();
+  this->SeriesList = u.Text();
+  this->Warnings = u.Text();
+  this->Summary = u.Text();
+  pixels.Photometric = u.Text();
   pixels.Encapsulated = u.Int() != 0;
-  pixels.Frames = u.Int();
+  pixels.Frames = static_cast<int>(u.Int());
   pixels.Columns = this->Dimensions[0];
   pixels.Rows = this->Dimensions[1];
   this->NumberOfComponents = pixels.Samples;
   in.Slices.assign(static_cast<std::size_t>(std::max(0, this->Dimensions[2])), Slice());
   for (Slice& s : in.Slices)
   {
-    s.Path = u.String();
-    s.Frame = u.Int();
-    s.Slope = u.Number();
-    s.Intercept = u.Number();
+    s.Path = u.Text();
+    s.Frame = static_cast<int>(u.Int());
+    s.Slope = u.Real();
+    s.Intercept = u.Real();
   }
   if (!u.Ok() || in.Slices.empty())
   {

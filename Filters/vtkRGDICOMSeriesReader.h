@@ -89,8 +89,8 @@ protected:
   vtkRGDICOMSeriesReader();
   ~vtkRGDICOMSeriesReader() override;
 
-  bool Scan(std::string& header, std::string& message) override;
-  bool Parse(const std::string& header, std::string& message) override;
+  bool Scan(std::vector<vtkIdType>& header, std::string& message) override;
+  bool Parse(const std::vector<vtkIdType>& header, std::string& message) override;
   bool ReadExtent(const int extent[6], vtkDataArray* scalars, std::string& message) override;
 
   char* SeriesInstanceUID = nullptr;

@@ -8,6 +8,7 @@
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 #include "vtkRGCompatibility.h"
+#include "vtkRGMessage.h"
 #include "vtkRGRunController.h"
 #include "vtkRGThreads.h"
 
@@ -970,16 +971,16 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
     return 0;
   }
   // Each rank's nearest vertex to each seed (a NaN met on the way is an error), gathered in the
-  // agreement: found, squared distance, key (exact in a double: below 2^53), position.
+  // agreement: per seed, the squared distance, the key (-1: none found), the position.
   const double minStep = geom.MinStep();
-  std::vector<double> mine(5 * numSeeds), all;
+  std::vector<vtkIdType> mine, all;
+  rgmc::MessageWriter hits(mine);
   for (int s = 0; s < numSeeds; ++s)
   {
     const rgmc::SeedHit hit = run.kernel->NearestVertex(
       &seedIndex[3 * s], &this->SeedPoints[3 * s], this->SeedSearchRadius, minStep);
-    mine[5 * s] = hit.Found ? hit.Distance2 : VTK_DOUBLE_MAX;
-    mine[5 * s + 1] = hit.Found ? static_cast<double>(hit.Key) : -1.0;
-    std::copy_n(hit.Point, 3, &mine[5 * s + 2]);
+    hits.Real(hit.Found ? hit.Distance2 : VTK_DOUBLE_MAX).Int(hit.Found ? hit.Key : -1);
+    hits.Real(hit.Point[0]).Real(hit.Point[1]).Real(hit.Point[2]);
   }
   run.problem = run.kernel->Error();
   if (!ranks.AgreeGather(run.problem.empty(), run.problem, mine, all))
@@ -996,13 +997,17 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
     double bestD2 = VTK_DOUBLE_MAX;
     for (int r = 0; r < ranks.Size; ++r)
     {
-      const double* hit = &all[5 * (numSeeds * r + s)];
-      const vtkIdType key = static_cast<vtkIdType>(hit[1]);
-      if (hit[1] >= 0 && (hit[0] < bestD2 || (hit[0] == bestD2 && key < bestKeys[s])))
+      rgmc::MessageReader hit(&all[5 * (numSeeds * r + s)], 5);
+      const double d2 = hit.Real();
+      const vtkIdType key = hit.Int();
+      if (key >= 0 && (d2 < bestD2 || (d2 == bestD2 && key < bestKeys[s])))
       {
-        bestD2 = hit[0];
+        bestD2 = d2;
         bestKeys[s] = key;
-        std::copy_n(hit + 2, 3, &bestPoints[3 * s]);
+        for (int a = 0; a < 3; ++a)
+        {
+          bestPoints[3 * s + a] = hit.Real();
+        }
       }
     }
   }

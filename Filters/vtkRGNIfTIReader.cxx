@@ -2,7 +2,7 @@
 // zlib (.nii.gz) to the bytes of its own slab.
 #include "vtkRGNIfTIReader.h"
 
-#include "vtkRGPacking.h"
+#include "vtkRGMessage.h"
 
 #include "vtkDataArray.h"
 #include "vtkMath.h"
@@ -638,7 +638,7 @@ std::string Summarize(const VolumeScan& scan)
 //  PASS 3 CheckVoxelData  the datatype, where the voxels start, a truncated .nii
 //  PASS 4 ReadScaling     scl_slope and scl_inter, and the output type they give
 //  PASS 5 PlaceVolume     sform, else qform, else pixdim; RAS turned into LPS
-bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
+bool vtkRGNIfTIReader::Scan(std::vector<vtkIdType>& header, std::string& message)
 {
   VolumeScan scan;
   scan.Path = this->FileName;
@@ -666,30 +666,30 @@ bool vtkRGNIfTIReader::Scan(std::string& header, std::string& message)
     return false;
   }
   // The header every rank parses, in the order Parse reads it.
-  rgmc::Packer p;
+  header.clear();
+  rgmc::MessageWriter p(header);
   PackGeometry(p, scan.Dimensions, scan.Spacing, scan.Origin, scan.Direction, type);
-  p.Number(scan.StoredType).Number(scan.BytesPerVoxel).Number(scan.Fields.Swap ? 1 : 0);
-  p.Number(scan.Fields.VoxOffset);
-  p.Number(scan.Slope).Number(scan.Intercept).Number(scan.GeometryMethod);
-  p.String(scan.Warnings.str()).String(Summarize(scan));
-  header = p.Text;
+  p.Int(scan.StoredType).Int(scan.BytesPerVoxel).Int(scan.Fields.Swap ? 1 : 0);
+  p.Real(scan.Fields.VoxOffset);
+  p.Real(scan.Slope).Real(scan.Intercept).Int(scan.GeometryMethod);
+  p.Text(scan.Warnings.str()).Text(Summarize(scan));
   return true;
 }
 
 //------------------------------------------------------------------------------
-bool vtkRGNIfTIReader::Parse(const std::string& header, std::string& message)
+bool vtkRGNIfTIReader::Parse(const std::vector<vtkIdType>& header, std::string& message)
 {
-  rgmc::Unpacker u(header);
+  rgmc::MessageReader u(header);
   this->UnpackGeometry(u);
-  this->DataType = u.Int();
-  this->BytesPerVoxel = u.Int();
+  this->DataType = static_cast<int>(u.Int());
+  this->BytesPerVoxel = static_cast<int>(u.Int());
   this->Swap = u.Int() != 0;
-  this->VoxelOffset = u.Number();
-  this->RescaleSlope = u.Number();
-  this->RescaleIntercept = u.Number();
-  this->GeometryMethod = u.Int();
-  this->Warnings = u.String();
-  this->Summary = u.String();
+  this->VoxelOffset = u.Real();
+  this->RescaleSlope = u.Real();
+  this->RescaleIntercept = u.Real();
+  this->GeometryMethod = static_cast<int>(u.Int());
+  this->Warnings = u.Text();
+  this->Summary = u.Text();
   this->NumberOfComponents = 1;
   this->ArrayName = "Intensity";
   if (!u.Ok())

@@ -56,8 +56,8 @@ protected:
   vtkRGNIfTIReader() = default;
   ~vtkRGNIfTIReader() override = default;
 
-  bool Scan(std::string& header, std::string& message) override;
-  bool Parse(const std::string& header, std::string& message) override;
+  bool Scan(std::vector<vtkIdType>& header, std::string& message) override;
+  bool Parse(const std::vector<vtkIdType>& header, std::string& message) override;
   bool ReadExtent(const int extent[6], vtkDataArray* scalars, std::string& message) override;
 
   double RescaleSlope = 1.0;

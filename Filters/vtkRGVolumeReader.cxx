@@ -3,7 +3,7 @@
 #include "vtkRGVolumeReader.h"
 
 #include "vtkRGCollective.h"
-#include "vtkRGPacking.h"
+#include "vtkRGMessage.h"
 #include "vtkRGRunController.h"
 
 #include "vtkDataArray.h"
@@ -93,7 +93,8 @@ int vtkRGVolumeReader::RequestInformation(
   if (this->GetMTime() > this->ScanTime || this->OutputScalarType == 0)
   {
     this->OutputScalarType = 0;
-    std::string header, message;
+    std::vector<vtkIdType> header;
+    std::string message;
     bool ok = true;
     if (ranks.Rank == 0)
     {
@@ -288,46 +289,46 @@ void vtkRGVolumeReader::PrintSelf(ostream& os, vtkIndent indent)
 }
 
 //------------------------------------------------------------------------------
-void vtkRGVolumeReader::PackGeometry(rgmc::Packer& p, const int dimensions[3],
+void vtkRGVolumeReader::PackGeometry(rgmc::MessageWriter& p, const int dimensions[3],
   const double spacing[3], const double origin[3], const double direction[9], int scalarType)
 {
   for (int a = 0; a < 3; ++a)
   {
-    p.Number(dimensions[a]);
+    p.Int(dimensions[a]);
   }
   for (int a = 0; a < 3; ++a)
   {
-    p.Number(spacing[a]);
+    p.Real(spacing[a]);
   }
   for (int a = 0; a < 3; ++a)
   {
-    p.Number(origin[a]);
+    p.Real(origin[a]);
   }
   for (int i = 0; i < 9; ++i)
   {
-    p.Number(direction[i]);
+    p.Real(direction[i]);
   }
-  p.Number(scalarType);
+  p.Int(scalarType);
 }
 
 //------------------------------------------------------------------------------
-void vtkRGVolumeReader::UnpackGeometry(rgmc::Unpacker& u)
+void vtkRGVolumeReader::UnpackGeometry(rgmc::MessageReader& u)
 {
   for (int a = 0; a < 3; ++a)
   {
-    this->Dimensions[a] = u.Int();
+    this->Dimensions[a] = static_cast<int>(u.Int());
   }
   for (int a = 0; a < 3; ++a)
   {
-    this->Spacing[a] = u.Number();
+    this->Spacing[a] = u.Real();
   }
   for (int a = 0; a < 3; ++a)
   {
-    this->Origin[a] = u.Number();
+    this->Origin[a] = u.Real();
   }
   for (double& d : this->Direction)
   {
-    d = u.Number();
+    d = u.Real();
   }
-  this->OutputScalarType = u.Int();
+  this->OutputScalarType = static_cast<int>(u.Int());
 }

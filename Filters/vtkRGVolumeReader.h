@@ -37,11 +37,12 @@
 #include "vtkImageAlgorithm.h"
 
 #include <string> // For std::string
+#include <vector> // For the header
 
 namespace rgmc
 {
-class Packer;
-class Unpacker;
+class MessageReader;
+class MessageWriter;
 }
 
 class vtkDataArray;
@@ -90,12 +91,12 @@ protected:
    * Rank 0 only: reads the headers and writes everything every rank needs into `header`.
    * Returns false with `message` (naming the file and the problem) on error.
    */
-  virtual bool Scan(std::string& header, std::string& message) = 0;
+  virtual bool Scan(std::vector<vtkIdType>& header, std::string& message) = 0;
 
   /**
    * Every rank: sets the members below (and the subclass's own) from the header of Scan.
    */
-  virtual bool Parse(const std::string& header, std::string& message) = 0;
+  virtual bool Parse(const std::vector<vtkIdType>& header, std::string& message) = 0;
 
   /**
    * Every rank: fills `scalars` (of OutputScalarType, NumberOfComponents components, allocated
@@ -122,9 +123,9 @@ protected:
    * PackGeometry (direction row-major), Parse reads them into the members below with
    * UnpackGeometry.
    */
-  static void PackGeometry(rgmc::Packer& p, const int dimensions[3], const double spacing[3],
+  static void PackGeometry(rgmc::MessageWriter& p, const int dimensions[3], const double spacing[3],
     const double origin[3], const double direction[9], int scalarType);
-  void UnpackGeometry(rgmc::Unpacker& u);
+  void UnpackGeometry(rgmc::MessageReader& u);
 
   /// Writes `count` values into `scalars` (of OutputScalarType) from tuple component `at`.
   static void Store(vtkDataArray* scalars, vtkIdType at, const double* values, std::size_t count);
