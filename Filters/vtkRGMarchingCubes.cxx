@@ -6,7 +6,7 @@
 #include "rgmcSurfaceKernel.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
-#include "vtkRGThreads.h"
+#include "vtkRGParallel.h"
 
 #include "vtkArrayDispatch.h"
 #include "vtkCellArray.h"

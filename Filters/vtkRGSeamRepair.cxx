@@ -7,7 +7,7 @@
 #include "rgmcSmoothing.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
-#include "vtkRGThreads.h"
+#include "vtkRGParallel.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
