@@ -25,11 +25,11 @@ each stage (its slowest rank's) and each rank's peak memory. Writes scale.md and
 
   python3 Scripts/rgmc_evaluate.py --threads  # or: ./rgmc evaluate --threads
 
-The threads benchmark instead: the build's rgmcThreads program, one rank, the CT phantom
-(512^3) at 1 and 2 threads through vtkSMPTools (STDThread unless --backend says otherwise; the
-backend that ran is recorded): vtkFlyingEdges3D, our seeded and all-components modes, Seam
-Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at every
-thread count. Writes threads.md and threads.json.
+The threads benchmark instead: the build's rgmcThreadsBenchmark program, one rank, the CT
+phantom (512^3) at 1 and 2 threads through vtkSMPTools (STDThread unless --backend says
+otherwise; the backend that ran is recorded): vtkFlyingEdges3D, our seeded and all-components
+modes, Seam Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at
+every thread count. Writes threads.md and threads.json.
 
   python3 Scripts/rgmc_evaluate.py --ranks-benchmark   # or: ./rgmc evaluate --ranks-benchmark
 
@@ -384,7 +384,7 @@ def run_threads(args):
     print("+ " + " ".join(command), flush=True)
     process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
     if process.returncode != 0:
-        raise rgmc_common.UsageError("rgmcThreads failed (exit %d)" % process.returncode)
+        raise rgmc_common.UsageError("rgmcThreadsBenchmark failed (exit %d)" % process.returncode)
     return json.loads(process.stdout)
 
 
@@ -519,12 +519,12 @@ def main(argv):
     parser.add_argument("--scale-period", type=float, default=24, help="the gyroid's period in voxels")
     parser.add_argument("--scale-binary", default=os.path.join(build, "bin", "rgmcScale"))
     parser.add_argument("--threads", action="store_true",
-                        help="the threads benchmark instead (rgmcThreads, one rank)")
+                        help="the threads benchmark instead (rgmcThreadsBenchmark, one rank)")
     parser.add_argument("--thread-counts", default="1,2", help="thread counts of --threads")
     parser.add_argument("--threads-size", type=int, default=512, help="the phantom's points per axis")
     parser.add_argument("--threads-repeats", type=int, default=3)
     parser.add_argument("--backend", default="STDThread", help="the vtkSMPTools backend of --threads")
-    parser.add_argument("--threads-binary", default=os.path.join(build, "bin", "rgmcThreads"))
+    parser.add_argument("--threads-binary", default=os.path.join(build, "bin", "rgmcThreadsBenchmark"))
     parser.add_argument("--ranks-benchmark", action="store_true",
                         help="the ranks benchmark instead (rgmcRanks on --ranks, default 1,2,4)")
     parser.add_argument("--ranks-size", type=int, default=256, help="the scaffold's points per axis")
