@@ -9,8 +9,8 @@
 #include "vtkRGCollective.h"
 #include "vtkRGCompatibility.h"
 #include "vtkRGMessage.h"
+#include "vtkRGParallel.h"
 #include "vtkRGRunController.h"
-#include "vtkRGThreads.h"
 
 #include "vtkArrayDispatch.h"
 #include "vtkCellArray.h"

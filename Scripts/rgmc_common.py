@@ -15,11 +15,16 @@ class UsageError(Exception):
     """A problem with the command line or the input, reported without a traceback."""
 
 
+def build_dir():
+    """The project's build tree, as ./rgmc chooses it: $RGMC_BUILD_DIR, else <root>/build."""
+    return os.path.abspath(os.environ.get("RGMC_BUILD_DIR") or os.path.join(ROOT, "build"))
+
+
 def find_plugin(explicit=None):
-    """The plugin library: --plugin, $RGMC_PLUGIN, or the project's build tree."""
+    """The plugin library: --plugin, $RGMC_PLUGIN, or the project's build tree (build_dir())."""
     candidates = [explicit, os.environ.get("RGMC_PLUGIN")]
     candidates += sorted(glob.glob(os.path.join(
-        ROOT, "build", "lib", "paraview-*", "plugins", "RGMarchingCubes", "RGMarchingCubes.so")))
+        build_dir(), "lib", "paraview-*", "plugins", "RGMarchingCubes", "RGMarchingCubes.so")))
     for path in candidates:
         if path and os.path.isfile(path):
             return os.path.abspath(path)

@@ -260,7 +260,7 @@ def main(argv):
     parser.add_argument("--random-seed", type=int, default=1,
                         help="seeds the phantom's noise, the UIDs and the file name shuffle")
     parser.add_argument("--defect", choices=sorted(DEFECTS), help="write a broken series")
-    parser.add_argument("--plugin", help="the plugin library (--phantom; default: found in build/)")
+    parser.add_argument("--plugin", help="the plugin library (--phantom; default: found in $RGMC_BUILD_DIR or build/)")
     args = parser.parse_args(argv)
     if args.slope == 0:
         parser.error("--slope must not be 0")

@@ -13,7 +13,8 @@ ParaView's Smooth: triangles, seconds (min and median of the repeats; a run's ti
 slowest rank's), peak memory per rank; the Hausdorff distances between the N-rank and 1-rank
 surfaces and between our smoothing and VTK's; and the time against the volume's size for the
 same sphere in 128^3 to 1024^3 of empty space. Writes report.md, results.json and PNG plots
-under build/evaluation/. Ranks above the core count are oversubscribed and marked so.
+under build/evaluation/ (the build tree is $RGMC_BUILD_DIR when set, as for ./rgmc). Ranks
+above the core count are oversubscribed and marked so.
 
   python3 Scripts/rgmc_evaluate.py --scale    # or: ./rgmc evaluate --scale
 
@@ -24,11 +25,11 @@ each stage (its slowest rank's) and each rank's peak memory. Writes scale.md and
 
   python3 Scripts/rgmc_evaluate.py --threads  # or: ./rgmc evaluate --threads
 
-The threads benchmark instead: the build's rgmcThreads program, one rank, the CT phantom
-(512^3) at 1 and 2 threads through vtkSMPTools (STDThread unless --backend says otherwise; the
-backend that ran is recorded): vtkFlyingEdges3D, our seeded and all-components modes, Seam
-Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at every
-thread count. Writes threads.md and threads.json.
+The threads benchmark instead: the build's rgmcThreadsBenchmark program, one rank, the CT
+phantom (512^3) at 1 and 2 threads through vtkSMPTools (STDThread unless --backend says
+otherwise; the backend that ran is recorded): vtkFlyingEdges3D, our seeded and all-components
+modes, Seam Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at
+every thread count. Writes threads.md and threads.json.
 
   python3 Scripts/rgmc_evaluate.py --ranks-benchmark   # or: ./rgmc evaluate --ranks-benchmark
 
@@ -383,7 +384,7 @@ def run_threads(args):
     print("+ " + " ".join(command), flush=True)
     process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
     if process.returncode != 0:
-        raise rgmc_common.UsageError("rgmcThreads failed (exit %d)" % process.returncode)
+        raise rgmc_common.UsageError("rgmcThreadsBenchmark failed (exit %d)" % process.returncode)
     return json.loads(process.stdout)
 
 
@@ -499,6 +500,7 @@ def write_results(folder, name, results, text):
 
 
 def main(argv):
+    build = rgmc_common.build_dir()
     parser = argparse.ArgumentParser(prog="rgmc_evaluate.py", description=__doc__.split("\n")[0])
     parser.add_argument("--cases", default="phantom256,phantom512,sphere512,blobs,mri")
     parser.add_argument("--ranks", default=None,
@@ -508,27 +510,27 @@ def main(argv):
     parser.add_argument("--sweep-repeats", type=int, default=3)
     parser.add_argument("--mri", default="/usr/share/mricron/templates/ch2.nii.gz")
     parser.add_argument("--quick", action="store_true", help="every size divided by 4 (a smoke run)")
-    parser.add_argument("--binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcEvaluation"))
-    parser.add_argument("--output", default=os.path.join(rgmc_common.ROOT, "build", "evaluation"),
+    parser.add_argument("--binary", default=os.path.join(build, "bin", "rgmcEvaluation"))
+    parser.add_argument("--output", default=os.path.join(build, "evaluation"),
                         help="folder for report.md, results.json and the plots")
     parser.add_argument("--scale", action="store_true",
                         help="the scale benchmark instead (rgmcScale on --ranks, default 1,2)")
     parser.add_argument("--scale-size", type=int, default=512, help="the gyroid's points per axis")
     parser.add_argument("--scale-period", type=float, default=24, help="the gyroid's period in voxels")
-    parser.add_argument("--scale-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcScale"))
+    parser.add_argument("--scale-binary", default=os.path.join(build, "bin", "rgmcScale"))
     parser.add_argument("--threads", action="store_true",
-                        help="the threads benchmark instead (rgmcThreads, one rank)")
+                        help="the threads benchmark instead (rgmcThreadsBenchmark, one rank)")
     parser.add_argument("--thread-counts", default="1,2", help="thread counts of --threads")
     parser.add_argument("--threads-size", type=int, default=512, help="the phantom's points per axis")
     parser.add_argument("--threads-repeats", type=int, default=3)
     parser.add_argument("--backend", default="STDThread", help="the vtkSMPTools backend of --threads")
-    parser.add_argument("--threads-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcThreads"))
+    parser.add_argument("--threads-binary", default=os.path.join(build, "bin", "rgmcThreadsBenchmark"))
     parser.add_argument("--ranks-benchmark", action="store_true",
                         help="the ranks benchmark instead (rgmcRanks on --ranks, default 1,2,4)")
     parser.add_argument("--ranks-size", type=int, default=256, help="the scaffold's points per axis")
     parser.add_argument("--ranks-phantom", type=int, default=512, help="the phantom's points per axis (0: none)")
     parser.add_argument("--ranks-repeats", type=int, default=4)
-    parser.add_argument("--ranks-binary", default=os.path.join(rgmc_common.ROOT, "build", "bin", "rgmcRanks"))
+    parser.add_argument("--ranks-binary", default=os.path.join(build, "bin", "rgmcRanks"))
     parser.add_argument("--report-only", action="store_true",
                         help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)

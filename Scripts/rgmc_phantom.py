@@ -22,7 +22,7 @@ def main(argv):
                         help="noise standard deviation in HU (default 12)")
     parser.add_argument("--random-seed", type=int, default=1, help="noise seed (default 1)")
     parser.add_argument("--output", required=True, help="the .vti file to write")
-    parser.add_argument("--plugin", help="the plugin library (default: found in build/)")
+    parser.add_argument("--plugin", help="the plugin library (default: found in $RGMC_BUILD_DIR or build/)")
     args = parser.parse_args(argv)
     if args.size < 2:
         parser.error("--size must be at least 2")

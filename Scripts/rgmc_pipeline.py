@@ -80,7 +80,7 @@ def parse_args(argv):
     parser.add_argument("--ranks", type=int, default=1,
                         help="number of MPI ranks (default 1); the command re-runs itself "
                         "under mpiexec when it is not already running on that many")
-    parser.add_argument("--plugin", help="the plugin library (default: found in build/)")
+    parser.add_argument("--plugin", help="the plugin library (default: found in $RGMC_BUILD_DIR or build/)")
     parser.add_argument("--connect", metavar="HOST:PORT",
                         help="run on a pvserver (e.g. mpiexec -n 8 pvserver on a cluster) instead "
                         "of here: run this command with pvpython; the server reads --input and "

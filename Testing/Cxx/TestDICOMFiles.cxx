@@ -1,7 +1,8 @@
 // vtkRGDICOMSeriesReader on the real DICOM files that Debian's python3-pydicom ships (many
 // transfer syntaxes, both byte orders, signed and unsigned, 1 to 32 bits, RGB, multi-frame),
-// against pydicom's own decoding (Testing/Python/pydicom_oracle.py, run with Debian's python3):
-// every file pydicom decodes must decode to the same samples after the modality LUT, exactly.
+// against pydicom's own decoding (Testing/Python/Modules/pydicom_oracle.py, run with Debian's
+// python3): every file pydicom decodes must decode to the same samples after the modality LUT,
+// exactly.
 // Files pydicom cannot decode are listed with pydicom's reason; the reader must still read them
 // or fail with a message, never crash; the truncated one must be reported as truncated; files
 // without pixel data must be refused with a message.
@@ -241,8 +242,8 @@ int main()
   }
   {
     // Structures scanners write, in pydicom's MR_small.dcm rewritten by pydicom itself
-    // (Testing/Python/dicom_quirks.py): a private sequence of undefined length with items of
-    // undefined length and a nested undefined-length sequence; a private element of odd length.
+    // (Testing/Python/Modules/dicom_quirks.py): a private sequence of undefined length with items
+    // of undefined length and a nested undefined-length sequence; a private element of odd length.
     const std::string quirks = work + "/structures";
     RGMC_CHECK(Run(std::string(RGMC_SYSTEM_PYTHON) + " " + RGMC_TESTING_PYTHON_DIR +
                  "/dicom_quirks.py " + RGMC_PYDICOM_DIR + " " + quirks),

@@ -17,7 +17,7 @@
 //   (exact), against our own index-space output transformed in double (1e-6 of the spacing),
 //   and against vtkMarchingCubes with a tolerance of float precision at the coordinates' size.
 #include "rgmcTestData.h"
-#include "rgmcThreads.h"
+#include "rgmcThreadCompare.h"
 
 #include "vtkCellData.h"
 #include "vtkFieldData.h"

@@ -8,7 +8,7 @@
 #include "vtkSmartPointer.h"
 
 #include "rgmcCheck.h"
-#include "rgmcThreads.h"
+#include "rgmcThreadCompare.h"
 
 #include <iostream>
 #include <string>

@@ -4,7 +4,7 @@
 #define rgmcDistributedData_h
 
 #include "rgmcTestData.h"
-#include "rgmcThreads.h"
+#include "rgmcThreadCompare.h"
 
 #include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"

@@ -11,8 +11,9 @@ import os
 import subprocess
 import sys
 
-import SummaryCompare
-import rgmc_testing
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+import SummaryCompare  # noqa: E402
+import rgmc_testing  # noqa: E402
 
 
 def main():
@@ -22,7 +23,7 @@ def main():
     parser.add_argument("--ranks", default="2,3")
     args = parser.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
-    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "PluginSummary.py")
+    script = rgmc_testing.in_paraview("PluginSummary.py")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
     summaries = {}

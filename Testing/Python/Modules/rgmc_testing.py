@@ -1,18 +1,27 @@
 """What the Python tests share: the list of failed checks, running a command with its output
-shown in the test's log, and how to start MPI and a private X server on every Debian release."""
+shown in the test's log, how to start MPI and a private X server on every Debian release, and
+where the scripts that run inside ParaView are (Testing/Python/InParaView)."""
 
 import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "Scripts"))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "Scripts"))
 import rgmc_common  # noqa: E402
+
+IN_PARAVIEW = os.path.normpath(os.path.join(HERE, "..", "InParaView"))
 
 # Xvfb resets whenever its last client disconnects; an MPI rank that connects during the reset
 # aborts with "bad X server connection". -noreset keeps the server up for the whole command.
 XVFB_SERVER_ARGS = "-screen 0 1280x1024x24 -noreset"
 
 failures = []
+
+
+def in_paraview(name):
+    """The path of `name`, a script that pvbatch, pvpython or the GUI runs for a test."""
+    return os.path.join(IN_PARAVIEW, name)
 
 
 def check(condition, what):

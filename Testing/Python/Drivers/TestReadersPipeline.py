@@ -21,8 +21,8 @@ import shutil
 import struct
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rgmc_testing import check, failures, mpiexec_command, run  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+from rgmc_testing import check, failures, in_paraview, mpiexec_command, run  # noqa: E402
 
 
 def stl_bounds(path):
@@ -107,7 +107,7 @@ def main():
     # File > Open under mpiexec: the plugin's readers, a slab per rank.
     out = os.path.join(args.workdir, "mpi.json")
     result = run(mpiexec_command(args.mpiexec, 2) + [args.pvbatch, "--mpi",
-                  os.path.join(os.path.dirname(os.path.abspath(__file__)), "ReadersMPI.py"),
+                  in_paraview("ReadersMPI.py"),
                   "--plugin", args.plugin, "--dicom", series, "--nifti",
                   os.path.join(args.mricron, "ch2.nii.gz"), "--out", out], env=env)
     check(result.returncode == 0, "ReadersMPI.py under mpiexec -n 2")

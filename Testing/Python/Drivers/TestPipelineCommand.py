@@ -12,7 +12,7 @@ import re
 import struct
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
 from rgmc_testing import check, failures, run, xvfb_run  # noqa: E402
 
 

@@ -18,7 +18,8 @@ import sys
 
 import numpy as np
 
-import rgmc_testing
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+import rgmc_testing  # noqa: E402
 
 ITERATIONS = 20
 RELAXATION = 0.1
@@ -111,7 +112,7 @@ def main():
     parser.add_argument("--ranks", default="1,2,3,4")
     args = parser.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
-    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "LaplacianMeshes.py")
+    script = rgmc_testing.in_paraview("LaplacianMeshes.py")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     failures = 0
     for ranks in [int(r) for r in args.ranks.split(",")]:

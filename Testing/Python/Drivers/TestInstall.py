@@ -12,6 +12,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+import rgmc_testing  # noqa: E402
+
 
 def main():
     parser = argparse.ArgumentParser()
@@ -26,7 +29,7 @@ def main():
     if len(plugins) != 1 or len(configs) != 1:
         print("FAILED: installed %s and %s" % (plugins, configs), file=sys.stderr)
         return 1
-    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "InstalledPlugin.py")
+    script = rgmc_testing.in_paraview("InstalledPlugin.py")
     base = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PV_PLUGIN_CONFIG_FILE")}
     failures = 0
     for name, value in (("PV_PLUGIN_PATH", os.path.dirname(plugins[0])), ("PV_PLUGIN_CONFIG_FILE", configs[0])):

@@ -36,8 +36,8 @@ try:  # pydicom 3 (Debian sid)
 except ImportError:  # pydicom 2 (Debian 12 and 13)
     from pydicom.pixel_data_handlers.util import apply_modality_lut
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rgmc_testing import check, failures, mpiexec_command, run  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+from rgmc_testing import check, failures, in_paraview, mpiexec_command, run  # noqa: E402
 
 TOLERANCE_MM = 1e-4
 SPACING = "0.7,0.8,1.25"
@@ -209,7 +209,7 @@ def main():
                   "%s: dcm2niix determines the slice spacing" % name)
 
     # The reader, as File > Open gives it, on 1 to 4 ranks: each rank's piece.
-    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "DICOMGeometryRead.py")
+    script = in_paraview("DICOMGeometryRead.py")
     series = ["%s=%s" % item for item in directories.items()]
     for ranks in [int(r) for r in args.ranks.split(",")]:
         out = os.path.join(args.workdir, "reader")

@@ -3,9 +3,9 @@
 // Seam Repair with 20 Laplacian iterations, at each thread count, through vtkSMPTools with the
 // backend asked for (the one that ran is recorded). Minimum of the repeats; JSON on stdout.
 //
-//   rgmcThreads [--size 512] [--threads 1,2] [--repeats 3] [--backend STDThread]
-#include "rgmcThreads.h" // Difference
+//   rgmcThreadsBenchmark [--size 512] [--threads 1,2] [--repeats 3] [--backend STDThread]
 #include "rgmcBenchmark.h"
+#include "rgmcThreadCompare.h" // Difference
 
 #include "vtkDummyController.h"
 #include "vtkFlyingEdges3D.h"
@@ -78,7 +78,8 @@ int main(int argc, char* argv[])
     }
     else
     {
-      std::cerr << "usage: rgmcThreads [--size N] [--threads 1,2] [--repeats N] [--backend B]\n";
+      std::cerr
+        << "usage: rgmcThreadsBenchmark [--size N] [--threads 1,2] [--repeats N] [--backend B]\n";
       return 2;
     }
   }

@@ -2,8 +2,8 @@
 // that ParaView's and VTK's settings govern them (VTK_SMP_BACKEND_IN_USE, VTK_SMP_MAX_THREADS),
 // with an exception thrown on a worker thread (std::bad_alloc) carried back to the calling
 // thread instead of terminating the process.
-#ifndef vtkRGThreads_h
-#define vtkRGThreads_h
+#ifndef vtkRGParallel_h
+#define vtkRGParallel_h
 
 #include "vtkSMPTools.h"
 #include "vtkType.h"

@@ -20,10 +20,9 @@ import subprocess
 import sys
 import time
 
-import SummaryCompare
-import rgmc_testing
-
-HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+import SummaryCompare  # noqa: E402
+import rgmc_testing  # noqa: E402
 
 
 def free_port():
@@ -72,7 +71,7 @@ def main():
     parser.add_argument("--ranks", default="2,3")
     args = parser.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
-    summary_script = os.path.join(HERE, "PluginSummary.py")
+    summary_script = rgmc_testing.in_paraview("PluginSummary.py")
     failures = []
 
     reference_path = os.path.join(args.workdir, "pvbatch-1.json")
@@ -106,7 +105,7 @@ def main():
 
     # A non-image input: VTK's message, on the client, naming the type the filter needs.
     with pvserver(args, 2, os.path.join(args.workdir, "pvserver-non-image.log")) as port:
-        result = run([args.pvpython, os.path.join(HERE, "NonImageClient.py"), "127.0.0.1", str(port), args.plugin])
+        result = run([args.pvpython, rgmc_testing.in_paraview("NonImageClient.py"), "127.0.0.1", str(port), args.plugin])
     text = result.stdout + result.stderr
     if "is of type vtkPolyData, but a vtkImageData is required" not in text or \
             "triangles from a sphere's polydata: 0" not in text:

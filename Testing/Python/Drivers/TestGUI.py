@@ -29,6 +29,9 @@ import zlib
 import numpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "Modules"))
+import rgmc_testing  # noqa: E402
+
 BACKGROUND = (82, 87, 110)  # the render view's background (GUIReady.py sets it), as 8-bit RGB
 
 
@@ -132,8 +135,8 @@ def main():
     os.makedirs(workdir)
     with open(os.path.join(HERE, "TestGUI.xml")) as template:
         events = template.read().replace("@WORKDIR@", workdir)
-    events = events.replace("@CHECKS@", os.path.join(HERE, "GUIChecks.py"))
-    events = events.replace("@READY@", os.path.join(HERE, "GUIReady.py"))
+    events = events.replace("@CHECKS@", rgmc_testing.in_paraview("GUIChecks.py"))
+    events = events.replace("@READY@", rgmc_testing.in_paraview("GUIReady.py"))
     script = os.path.join(workdir, "TestGUI.xml")
     with open(script, "w") as out:
         out.write(events)

@@ -2,8 +2,8 @@
 // vtkSMPTools with the STDThread backend and N threads, and also with 1 thread, and checks that
 // the two outputs are bitwise identical (every array of the output, in order); its own checks
 // then run on the N-thread output. Without --threads, filters update as configured.
-#ifndef rgmcThreads_h
-#define rgmcThreads_h
+#ifndef rgmcThreadCompare_h
+#define rgmcThreadCompare_h
 
 #include "rgmcCheck.h"
 

@@ -14,7 +14,7 @@ from vtkmodules.vtkCommonDataModel import vtkStaticPointLocator
 from vtkmodules.vtkFiltersCore import (vtkCleanPolyData, vtkMarchingCubes,
                                        vtkPolyDataConnectivityFilter)
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
 from rgmc_testing import check, failures  # noqa: E402
 
 
