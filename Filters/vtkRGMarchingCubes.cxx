@@ -686,46 +686,57 @@ int vtkRGMarchingCubes::RequestData(
 bool vtkRGMarchingCubes::CheckInput(
   Run& run, vtkImageData* input, vtkInformationVector** inputVector)
 {
-  Ranks& ranks = run.ranks;
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   run.hasPoints = input && input->GetNumberOfPoints() > 0;
-  // The whole extent, agreed by all ranks: the union of what each rank was told and what it
-  // holds (pieces handed over without a pipeline know only their own extent). One MIN
-  // reduction of the lows and the negated highs.
+  this->AgreeOnWholeExtent(run, input, inputVector[0]->GetInformationObject(0));
+  run.problem = this->DescribeInputProblem(run, input, inputVector);
+  return this->GatherPieces(run, input);
+}
+
+//------------------------------------------------------------------------------
+// The whole extent, agreed by all ranks: the union of what each rank was told and what it holds
+// (pieces handed over without a pipeline know only their own extent). One MIN reduction of the
+// lows and the negated highs.
+void vtkRGMarchingCubes::AgreeOnWholeExtent(Run& run, vtkImageData* input, vtkInformation* inInfo)
+{
+  int told[6] = { 0, -1, 0, -1, 0, -1 }, held[6] = { 0, -1, 0, -1, 0, -1 };
+  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
   {
-    int told[6] = { 0, -1, 0, -1, 0, -1 }, held[6] = { 0, -1, 0, -1, 0, -1 };
-    if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), told);
+  }
+  if (run.hasPoints)
+  {
+    input->GetExtent(held);
+  }
+  int mine[6], agreed[6];
+  for (int a = 0; a < 3; ++a)
+  {
+    mine[a] = VTK_INT_MAX;
+    mine[3 + a] = VTK_INT_MAX; // -high
+    for (const int* e : { told, held })
     {
-      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), told);
-    }
-    if (run.hasPoints)
-    {
-      input->GetExtent(held);
-    }
-    int mine[6], agreed[6];
-    for (int a = 0; a < 3; ++a)
-    {
-      mine[a] = VTK_INT_MAX;
-      mine[3 + a] = VTK_INT_MAX; // -high
-      for (const int* e : { told, held })
+      if (e[1] >= e[0] && e[3] >= e[2] && e[5] >= e[4])
       {
-        if (e[1] >= e[0] && e[3] >= e[2] && e[5] >= e[4])
-        {
-          mine[a] = std::min(mine[a], e[2 * a]);
-          mine[3 + a] = std::min(mine[3 + a], -e[2 * a + 1]);
-        }
-      }
-    }
-    ranks.AllReduce(mine, agreed, 6, vtkCommunicator::MIN_OP, "a reduction");
-    if (agreed[0] <= -agreed[3])
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        run.whole[2 * a] = agreed[a];
-        run.whole[2 * a + 1] = -agreed[3 + a];
+        mine[a] = std::min(mine[a], e[2 * a]);
+        mine[3 + a] = std::min(mine[3 + a], -e[2 * a + 1]);
       }
     }
   }
+  run.ranks.AllReduce(mine, agreed, 6, vtkCommunicator::MIN_OP, "a reduction");
+  if (agreed[0] <= -agreed[3])
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      run.whole[2 * a] = agreed[a];
+      run.whole[2 * a + 1] = -agreed[3 + a];
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+// What is wrong with this rank's input (empty: nothing); the scalars to contour, when found.
+std::string vtkRGMarchingCubes::DescribeInputProblem(
+  Run& run, vtkImageData* input, vtkInformationVector** inputVector)
+{
   const int* whole = run.whole;
   std::ostringstream msg;
   if (whole[1] < whole[0] || whole[3] < whole[2] || whole[5] < whole[4])
@@ -750,53 +761,66 @@ bool vtkRGMarchingCubes::CheckInput(
   }
   else if (run.hasPoints)
   {
-    int association = vtkDataObject::FIELD_ASSOCIATION_POINTS;
-    vtkDataArray* scalars = this->GetInputArrayToProcess(0, inputVector, association);
-    vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
-    const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
-      ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
-      : nullptr;
-    if (scalars && association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
+    this->CheckScalars(run, input, inputVector, msg);
+  }
+  return msg.str();
+}
+
+//------------------------------------------------------------------------------
+void vtkRGMarchingCubes::CheckScalars(
+  Run& run, vtkImageData* input, vtkInformationVector** inputVector, std::ostream& msg)
+{
+  int association = vtkDataObject::FIELD_ASSOCIATION_POINTS;
+  vtkDataArray* scalars = this->GetInputArrayToProcess(0, inputVector, association);
+  vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
+  const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
+    ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  if (scalars && association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
+  {
+    msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "")
+        << "' is cell data; contouring needs point data (apply Cell Data to Point Data "
+           "first)";
+  }
+  else if (!scalars)
+  {
+    if (name && input->GetCellData()->GetArray(name))
     {
-      msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "")
+      msg << "the array '" << name
           << "' is cell data; contouring needs point data (apply Cell Data to Point Data "
              "first)";
     }
-    else if (!scalars)
+    else if (name)
     {
-      if (name && input->GetCellData()->GetArray(name))
-      {
-        msg << "the array '" << name
-            << "' is cell data; contouring needs point data (apply Cell Data to Point Data "
-               "first)";
-      }
-      else if (name)
-      {
-        msg << "the input has no point array named '" << name << "'";
-      }
-      else
-      {
-        msg << "the input has no point scalars to contour (it has "
-            << input->GetPointData()->GetNumberOfArrays() << " point arrays and "
-            << input->GetCellData()->GetNumberOfArrays()
-            << " cell arrays, none of them active point scalars)";
-      }
-    }
-    else if (scalars->GetNumberOfComponents() != 1)
-    {
-      msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "") << "' has "
-          << scalars->GetNumberOfComponents()
-          << " components; contour one component (extract it first, e.g. with Calculator)";
+      msg << "the input has no point array named '" << name << "'";
     }
     else
     {
-      run.scalars = scalars;
+      msg << "the input has no point scalars to contour (it has "
+          << input->GetPointData()->GetNumberOfArrays() << " point arrays and "
+          << input->GetCellData()->GetNumberOfArrays()
+          << " cell arrays, none of them active point scalars)";
     }
   }
-  run.problem = msg.str();
-  // One agreement that also gathers each rank's cells (those not marked ghost, and all of its
-  // extent), whether it has points, and its geometry: the lowest rank with points gives
-  // everybody its geometry (a rank without data may carry default geometry).
+  else if (scalars->GetNumberOfComponents() != 1)
+  {
+    msg << "the array '" << (scalars->GetName() ? scalars->GetName() : "") << "' has "
+        << scalars->GetNumberOfComponents()
+        << " components; contour one component (extract it first, e.g. with Calculator)";
+  }
+  else
+  {
+    run.scalars = scalars;
+  }
+}
+
+//------------------------------------------------------------------------------
+// One agreement that also gathers each rank's cells (those not marked ghost, and all of its
+// extent), whether it has points, and its geometry: the lowest rank with points gives everybody
+// its geometry (a rank without data may carry default geometry).
+bool vtkRGMarchingCubes::GatherPieces(Run& run, vtkImageData* input)
+{
+  Ranks& ranks = run.ranks;
   rgmc::CellBox myCells, allMine;
   if (run.problem.empty() && run.hasPoints && run.scalars)
   {
@@ -808,21 +832,26 @@ bool vtkRGMarchingCubes::CheckInput(
     allMine.Lo[a] = run.local[2 * a];
     allMine.Hi[a] = run.local[2 * a + 1] - 1;
   }
+  // Per rank: whether it has points, its two boxes, origin, spacing, direction.
   constexpr std::size_t PerRank = 1 + 12 + 15;
-  std::vector<double> mine(PerRank, 0.0), all;
-  mine[0] = run.hasPoints ? 1.0 : 0.0;
-  for (int a = 0; a < 3; ++a)
-  {
-    mine[1 + a] = myCells.Lo[a];
-    mine[4 + a] = myCells.Hi[a];
-    mine[7 + a] = allMine.Lo[a];
-    mine[10 + a] = allMine.Hi[a];
-  }
+  double geometry[15] = { 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
   if (run.hasPoints)
   {
-    input->GetOrigin(&mine[13]);
-    input->GetSpacing(&mine[16]);
-    std::copy_n(input->GetDirectionMatrix()->GetData(), 9, &mine[19]);
+    input->GetOrigin(geometry);
+    input->GetSpacing(geometry + 3);
+    std::copy_n(input->GetDirectionMatrix()->GetData(), 9, geometry + 6);
+  }
+  std::vector<vtkIdType> mine, all;
+  rgmc::MessageWriter piece(mine);
+  piece.Int(run.hasPoints ? 1 : 0);
+  for (const rgmc::CellBox* box : { &myCells, &allMine })
+  {
+    piece.Int(box->Lo[0]).Int(box->Lo[1]).Int(box->Lo[2]);
+    piece.Int(box->Hi[0]).Int(box->Hi[1]).Int(box->Hi[2]);
+  }
+  for (double g : geometry)
+  {
+    piece.Real(g);
   }
   if (!ranks.AgreeGather(run.problem.empty(), run.problem, mine, all))
   {
@@ -833,14 +862,24 @@ bool vtkRGMarchingCubes::CheckInput(
   run.extentBoxes.resize(ranks.Size);
   for (int r = ranks.Size - 1; r >= 0; --r)
   {
-    const double* theirs = &all[PerRank * r];
-    source = theirs[0] != 0.0 ? r : source;
-    for (int a = 0; a < 3; ++a)
+    rgmc::MessageReader theirs(&all[PerRank * r], PerRank);
+    source = theirs.Int() != 0 ? r : source;
+    for (rgmc::CellBox* box : { &run.cellBoxes[r], &run.extentBoxes[r] })
     {
-      run.cellBoxes[r].Lo[a] = static_cast<int>(theirs[1 + a]);
-      run.cellBoxes[r].Hi[a] = static_cast<int>(theirs[4 + a]);
-      run.extentBoxes[r].Lo[a] = static_cast<int>(theirs[7 + a]);
-      run.extentBoxes[r].Hi[a] = static_cast<int>(theirs[10 + a]);
+      for (int* bound : { box->Lo, box->Hi })
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          bound[a] = static_cast<int>(theirs.Int());
+        }
+      }
+    }
+    if (r == source)
+    {
+      for (double& g : geometry)
+      {
+        g = theirs.Real();
+      }
     }
   }
   if (source < 0)
@@ -848,10 +887,9 @@ bool vtkRGMarchingCubes::CheckInput(
     run.problem = "the input image has no points"; // the same verdict on every rank
     return false;
   }
-  const double* g = &all[PerRank * source];
-  std::copy_n(g + 13, 3, run.geometry.Origin);
-  std::copy_n(g + 16, 3, run.geometry.Spacing);
-  std::copy_n(g + 19, 9, run.geometry.Direction);
+  std::copy_n(geometry, 3, run.geometry.Origin);
+  std::copy_n(geometry + 3, 3, run.geometry.Spacing);
+  std::copy_n(geometry + 6, 9, run.geometry.Direction);
   return true;
 }
 

@@ -77,6 +77,7 @@
 #include "RGMCFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
+#include <string> // For DescribeInputProblem
 #include <vector> // For the seed points
 
 class vtkImageData;
@@ -227,6 +228,12 @@ private:
   // that fails leaves the agreed message in the run.
   struct Run;
   bool CheckInput(Run& run, vtkImageData* input, vtkInformationVector** inputVector);
+  void AgreeOnWholeExtent(Run& run, vtkImageData* input, vtkInformation* inInfo);
+  std::string DescribeInputProblem(
+    Run& run, vtkImageData* input, vtkInformationVector** inputVector);
+  void CheckScalars(
+    Run& run, vtkImageData* input, vtkInformationVector** inputVector, std::ostream& msg);
+  bool GatherPieces(Run& run, vtkImageData* input);
   void AssignCubes(Run& run);
   /// 1: every seed has a vertex; 0: no surface near a seed (warned); -1: an error.
   int FindSeeds(Run& run);

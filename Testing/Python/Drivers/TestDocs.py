@@ -22,7 +22,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [os.path.join(HERE, "..", "Modules"), os.path.join(HERE, "..")]
-from rgmc_testing import check, failures, run, xvfb_run  # noqa: E402
+from rgmc_testing import check, finish, run, xvfb_run  # noqa: E402
 
 README_MAX_LINES = 300
 # The README's set-up commands, exactly as a newcomer types them.
@@ -305,11 +305,7 @@ def main():
     if not args.no_run:
         run_blocks(args, pages)
 
-    if failures:
-        print("TestDocs: %d check(s) failed" % len(failures), file=sys.stderr)
-        return 1
-    print("TestDocs: all checks passed")
-    return 0
+    return finish("TestDocs")
 
 
 sys.exit(main())

@@ -11,7 +11,6 @@ points, within 2 units in the last place with float points.
       --workdir DIR --ranks 1,2,3,4
 """
 
-import argparse
 import os
 import subprocess
 import sys
@@ -106,14 +105,9 @@ def jacobi(points, v, w):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    for name in ("--pvbatch", "--mpiexec", "--plugin", "--workdir"):
-        parser.add_argument(name, required=True)
-    parser.add_argument("--ranks", default="1,2,3,4")
-    args = parser.parse_args()
-    os.makedirs(args.workdir, exist_ok=True)
+    args = rgmc_testing.mpi_driver_arguments("1,2,3,4")
     script = rgmc_testing.in_paraview("LaplacianMeshes.py")
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    env = rgmc_testing.mpi_environment()
     failures = 0
     for ranks in [int(r) for r in args.ranks.split(",")]:
         prefix = os.path.join(args.workdir, "skull-%d" % ranks)

@@ -13,7 +13,7 @@ import struct
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
-from rgmc_testing import check, failures, run, xvfb_run  # noqa: E402
+from rgmc_testing import check, finish, run, xvfb_run  # noqa: E402
 
 
 def stl_triangles(path):
@@ -117,11 +117,7 @@ def main():
         check(message in result.stdout + result.stderr, "%s: says %r" % (" ".join(extra), message))
     check(not os.path.exists(os.path.join(args.workdir, "bad.stl")), "nothing written on failure")
 
-    if failures:
-        print("TestPipelineCommand: %d check(s) failed" % len(failures), file=sys.stderr)
-        return 1
-    print("TestPipelineCommand: all checks passed")
-    return 0
+    return finish("TestPipelineCommand")
 
 
 sys.exit(main())

@@ -5,7 +5,6 @@ and under mpiexec on several; every run must give exactly the 1-rank surfaces.
       --workdir DIR --ranks 2,3
 """
 
-import argparse
 import json
 import os
 import subprocess
@@ -17,14 +16,9 @@ import rgmc_testing  # noqa: E402
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    for name in ("--pvbatch", "--mpiexec", "--plugin", "--workdir"):
-        parser.add_argument(name, required=True)
-    parser.add_argument("--ranks", default="2,3")
-    args = parser.parse_args()
-    os.makedirs(args.workdir, exist_ok=True)
+    args = rgmc_testing.mpi_driver_arguments("2,3")
     script = rgmc_testing.in_paraview("PluginSummary.py")
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    env = rgmc_testing.mpi_environment()
 
     summaries = {}
     for ranks in [1] + [int(r) for r in args.ranks.split(",")]:

@@ -2,6 +2,7 @@
 shown in the test's log, how to start MPI and a private X server on every Debian release, and
 where the scripts that run inside ParaView are (Testing/Python/InParaView)."""
 
+import argparse
 import os
 import subprocess
 import sys
@@ -29,6 +30,33 @@ def check(condition, what):
     if not condition:
         failures.append(what)
         print("FAILED: %s" % what, file=sys.stderr)
+
+
+def mpi_driver_arguments(default_ranks):
+    """The arguments of a driver that runs a ParaView script on several rank counts: --pvbatch,
+    --mpiexec, --plugin, --workdir (made here) and --ranks (comma-separated)."""
+    parser = argparse.ArgumentParser()
+    for name in ("--pvbatch", "--mpiexec", "--plugin", "--workdir"):
+        parser.add_argument(name, required=True)
+    parser.add_argument("--ranks", default=default_ranks)
+    args = parser.parse_args()
+    os.makedirs(args.workdir, exist_ok=True)
+    return args
+
+
+def mpi_environment():
+    """The environment for mpiexec: Open MPI refuses root without these."""
+    return dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def finish(name):
+    """The driver's exit code once its checks are done: 1, with the number that failed, when
+    any did."""
+    if failures:
+        print("%s: %d check(s) failed" % (name, len(failures)), file=sys.stderr)
+        return 1
+    print("%s: all checks passed" % name)
+    return 0
 
 
 def run(command, timeout=900, env=None, tail=None):
