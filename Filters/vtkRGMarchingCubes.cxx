@@ -256,74 +256,27 @@ rgmc::CellBox OwnedCells(vtkImageData* input)
   return found;
 }
 
-// ---- the kernel behind one interface, whatever the array type ------------------------------
+// ---- the kernel over the input's samples, whatever the array type ---------------------------
 
-class AnyKernel
+/// The samples' range, constructed before the kernel that keeps a reference to it.
+template <typename Range>
+struct SamplesHolder
 {
-public:
-  virtual ~AnyKernel() = default;
-  virtual rgmc::SeedHit NearestVertex(
-    const double idx[3], const double x[3], double radius, double minStep) = 0;
-  virtual int GrowFromKey(std::int64_t key) = 0;
-  virtual void GrowAll() = 0;
-  virtual void GrowBoundary() = 0;
-  virtual void Extract() = 0;
-  virtual rgmc::LocalMesh& Mesh() = 0;
-  virtual rgmc::ComponentSet& Components() = 0;
-  virtual std::vector<rgmc::Port>& Ports() = 0;
-  virtual std::string Error() const = 0;
-  virtual bool Aborted() const = 0;
-  virtual bool MissingGhosts() const = 0;
-  virtual void SetCrossRanks(bool cross) = 0;
-  virtual void SetBudget(std::int64_t budget) = 0;
-  virtual bool Busy() const = 0;
-  virtual void Continue() = 0;
-  virtual std::vector<rgmc::Departure> TakeDepartures() = 0;
-  virtual void GrowFromArrivals(const std::vector<rgmc::Arrival>& arrivals, int numLabels) = 0;
-  virtual std::int64_t CubesExamined() const = 0;
-  virtual std::int64_t PlanePointsRead() const = 0;
+  Range Samples;
 };
 
+/// The kernel (rgmc::Kernel's implementation) with the samples it reads.
 template <typename Range>
-class KernelOf : public AnyKernel
+struct KernelOnSamples
+  : SamplesHolder<Range>
+  , rgmc::SurfaceKernel<Range>
 {
-public:
-  KernelOf(const Range& values, const rgmc::Grid& grid, const rgmc::Ownership& own,
+  KernelOnSamples(const Range& samples, const rgmc::Grid& grid, const rgmc::Ownership& own,
     const rgmc::SurfaceOptions& options)
-    : Values(values)
-    , Kernel(Cases(), grid, own, this->Values, options)
+    : SamplesHolder<Range>{ samples }
+    , rgmc::SurfaceKernel<Range>(Cases(), grid, own, this->Samples, options)
   {
   }
-  rgmc::SeedHit NearestVertex(
-    const double idx[3], const double x[3], double radius, double minStep) override
-  {
-    return this->Kernel.NearestVertex(idx, x, radius, minStep);
-  }
-  int GrowFromKey(std::int64_t key) override { return this->Kernel.GrowFromKey(key); }
-  void GrowAll() override { this->Kernel.GrowAll(); }
-  void GrowBoundary() override { this->Kernel.GrowBoundary(); }
-  void Extract() override { this->Kernel.Extract(); }
-  rgmc::LocalMesh& Mesh() override { return this->Kernel.Mesh(); }
-  rgmc::ComponentSet& Components() override { return this->Kernel.Components; }
-  std::vector<rgmc::Port>& Ports() override { return this->Kernel.Ports(); }
-  std::string Error() const override { return this->Kernel.Error(); }
-  bool Aborted() const override { return this->Kernel.Aborted(); }
-  bool MissingGhosts() const override { return this->Kernel.MissingGhosts(); }
-  void SetCrossRanks(bool cross) override { this->Kernel.SetCrossRanks(cross); }
-  void SetBudget(std::int64_t budget) override { this->Kernel.SetBudget(budget); }
-  bool Busy() const override { return this->Kernel.Busy(); }
-  void Continue() override { this->Kernel.Continue(); }
-  std::vector<rgmc::Departure> TakeDepartures() override { return this->Kernel.TakeDepartures(); }
-  void GrowFromArrivals(const std::vector<rgmc::Arrival>& arrivals, int numLabels) override
-  {
-    this->Kernel.GrowFromArrivals(arrivals, numLabels);
-  }
-  std::int64_t CubesExamined() const override { return this->Kernel.CubesExamined(); }
-  std::int64_t PlanePointsRead() const override { return this->Kernel.PlanePointsRead(); }
-
-private:
-  Range Values;
-  rgmc::SurfaceKernel<Range> Kernel;
 };
 
 /// Stands in for the samples on a rank that has none (it owns no cube, so nothing is read).
@@ -337,13 +290,13 @@ struct MakeKernel
   const rgmc::Grid* Grid;
   const rgmc::Ownership* Own;
   const rgmc::SurfaceOptions* Options;
-  std::unique_ptr<AnyKernel> Result;
+  std::unique_ptr<rgmc::Kernel> Result;
 
   template <typename ArrayT>
   void operator()(ArrayT* array)
   {
     using Range = decltype(vtk::DataArrayValueRange<1>(array));
-    this->Result.reset(new KernelOf<Range>(
+    this->Result.reset(new KernelOnSamples<Range>(
       vtk::DataArrayValueRange<1>(array), *this->Grid, *this->Own, *this->Options));
   }
 };
@@ -387,8 +340,8 @@ struct RankGraph : rgmc::ComponentGraph
 
   /// Numbers the roots, lists their totals, and sorts the ports by the ranks that own the other
   /// cubes around them. Local work.
-  void Prepare(
-    AnyKernel& kernel, const rgmc::Grid& grid, const rgmc::Ownership& own, int rank, int numRanks)
+  void Prepare(rgmc::Kernel& kernel, const rgmc::Grid& grid, const rgmc::Ownership& own, int rank,
+    int numRanks)
   {
     rgmc::ComponentSet& comps = kernel.Components();
     this->RootIndex.assign(comps.Size(), -1);
@@ -589,7 +542,7 @@ struct vtkRGMarchingCubes::Run
   int local[6] = { 0, -1, 0, -1, 0, -1 };
   std::unique_ptr<rgmc::Ownership> own;
   std::unique_ptr<rgmc::Grid> grid;
-  std::unique_ptr<AnyKernel> kernel;
+  std::unique_ptr<rgmc::Kernel> kernel;
   std::vector<rgmc::CellBox> cellBoxes;   // per rank: its cells not marked ghost
   std::vector<rgmc::CellBox> extentBoxes; // per rank: all the cells of its extent
   std::vector<vtkIdType> seedKeys;
@@ -613,6 +566,7 @@ struct vtkRGMarchingCubes::Run
 //  PASS 0 CheckInput       AllReduce (whole extent), agreement gathering every rank's boxes
 //                          of cells, whether it has points, and its geometry
 //  PASS 1 AssignCubes      none (ownership and neighbours from the gathered boxes)
+//         BuildKernel      none
 //  PASS 2 FindSeeds        Seeded mode only: agreement gathering each rank's nearest vertex
 //                          to each seed; GlobalRange (2 AllReduce) when there is none
 //  PASS 3 GrowAndExtract   Seeded on several ranks: per round an agreement (status, anything
@@ -646,8 +600,9 @@ int vtkRGMarchingCubes::RequestData(
     return 0;
   }
   this->UpdateProgress(0.05);
-  // PASS 1: ownership of cubes.
+  // PASS 1: ownership of cubes; the kernel over this rank's samples.
   this->AssignCubes(run);
+  this->BuildKernel(run);
   // PASS 2: seeds, each to its nearest surface vertex over all ranks.
   if (this->ExtractionMode == SEEDED)
   {
@@ -937,7 +892,13 @@ void vtkRGMarchingCubes::AssignCubes(Run& run)
   }
   run.own.reset(new rgmc::Ownership(cellBoxes, ranks.Rank));
   run.grid.reset(new rgmc::Grid(whole, run.local));
+}
 
+//------------------------------------------------------------------------------
+// The kernel over this rank's samples (of any array type; a rank without samples owns no cube
+// and reads none), with the isovalue, the options and the geometry.
+void vtkRGMarchingCubes::BuildKernel(Run& run)
+{
   rgmc::SurfaceOptions options;
   options.Isovalue = this->Isovalue;
   options.ComputeNormals = this->ComputeNormals;
@@ -967,7 +928,7 @@ void vtkRGMarchingCubes::AssignCubes(Run& run)
   }
   else
   {
-    make.Result.reset(new KernelOf<NoValues>(NoValues(), *run.grid, *run.own, options));
+    make.Result.reset(new KernelOnSamples<NoValues>(NoValues(), *run.grid, *run.own, options));
   }
   run.kernel = std::move(make.Result);
 }
@@ -1081,7 +1042,7 @@ int vtkRGMarchingCubes::FindSeeds(Run& run)
 int vtkRGMarchingCubes::GrowAndExtract(Run& run)
 {
   Ranks& ranks = run.ranks;
-  AnyKernel& kernel = *run.kernel;
+  rgmc::Kernel& kernel = *run.kernel;
   const bool rounds = this->ExtractionMode == SEEDED && ranks.Size > 1;
   bool aborted = false;
   if (rounds)
@@ -1176,7 +1137,7 @@ int vtkRGMarchingCubes::GrowAndExtract(Run& run)
 bool vtkRGMarchingCubes::GrowInRounds(Run& run, bool& aborted)
 {
   Ranks& ranks = run.ranks;
-  AnyKernel& kernel = *run.kernel;
+  rgmc::Kernel& kernel = *run.kernel;
   const rgmc::Grid& grid = *run.grid;
   const rgmc::Ownership& own = *run.own;
   std::string problem;

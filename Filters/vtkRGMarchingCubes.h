@@ -235,6 +235,7 @@ private:
     Run& run, vtkImageData* input, vtkInformationVector** inputVector, std::ostream& msg);
   bool GatherPieces(Run& run, vtkImageData* input);
   void AssignCubes(Run& run);
+  void BuildKernel(Run& run);
   /// 1: every seed has a vertex; 0: no surface near a seed (warned); -1: an error.
   int FindSeeds(Run& run);
   /// 1: done; 0: aborted; -1: an error.

@@ -429,7 +429,6 @@ public:
     , Owned(ownership)
     , Samples(values)
     , Options(options)
-    , Isovalue(options.Isovalue)
   {
     for (int v = 0; v < 8; ++v)
     {
@@ -452,8 +451,7 @@ public:
   const Grid& GridOf;
   const Ownership& Owned;
   const Values& Samples;
-  const SurfaceOptions Options;
-  const double Isovalue;
+  const SurfaceOptions Options; // the isovalue among them
 
   // ---- state shared by the passes ------------------------------------------------------------
 
@@ -553,8 +551,8 @@ public:
         return false;
       }
       st.S[v] = s;
-      code |= (s >= this->Isovalue) << v;
-      degenerate |= (s == this->Isovalue);
+      code |= (s >= this->Options.Isovalue) << v;
+      degenerate |= (s == this->Options.Isovalue);
     }
     st.Case = code;
     st.Degenerate = degenerate;
@@ -564,7 +562,7 @@ public:
   /// The surface nodes of cube (i, j, k) with samples `st`.
   RGMC_INLINE void Describe(int i, int j, int k, const CubeSamples& st, CubeSurface& surface) const
   {
-    surface.Set(this->Table, this->GridOf, this->Isovalue, i, j, k, st);
+    surface.Set(this->Table, this->GridOf, this->Options.Isovalue, i, j, k, st);
   }
 
   // ---- vertex geometry -----------------------------------------------------------------------
@@ -582,7 +580,7 @@ public:
   /// as vtkMarchingCubes does (x = p_lo + t (p_hi - p_lo)); returns t.
   double EdgePosition(const int p[3], int axis, double sLo, double sHi, double x[3]) const
   {
-    const double t = (this->Isovalue - sLo) / (sHi - sLo);
+    const double t = (this->Options.Isovalue - sLo) / (sHi - sLo);
     double idx[3] = { double(p[0]), double(p[1]), double(p[2]) };
     idx[axis] = idx[axis] + t * 1.0;
     this->ToWorld(idx, x);

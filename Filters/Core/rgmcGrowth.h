@@ -556,7 +556,7 @@ private:
     SampledVolume<Values>& volume = this->Volume;
     const CellBox& box = volume.Owned.Mine();
     const Grid& grid = volume.GridOf;
-    const double c = volume.Isovalue;
+    const double c = volume.Options.Isovalue;
     const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
     int p[3];
     p[axis] = plane;

@@ -3,7 +3,8 @@
 // and the kernel's unit tests drive them.
 //
 // Layers, each file including only those below it:
-//   rgmcSurfaceKernel.h   this file: the three passes over one piece
+//   rgmcSurfaceKernel.h   this file: the kernel's interface (Kernel), and the three passes over
+//                         one piece behind it (SurfaceKernel)
 //   rgmcSeedSearch.h, rgmcGrowth.h, rgmcExtraction.h
 //   rgmcCubeSurface.h     samples, vertex geometry, a cube's surface nodes, components
 //   rgmcCaseTable.h, rgmcGrid.h, rgmcUnionFind.h, rgmcKeyMap.h, rgmcBuffer.h
@@ -20,53 +21,85 @@
 namespace rgmc
 {
 
+/// What the VTK layer drives, whatever the type of the samples: declared once, implemented by
+/// SurfaceKernel.
+class Kernel
+{
+public:
+  virtual ~Kernel() = default;
+
+  /// See rgmc::NearestVertex.
+  virtual SeedHit NearestVertex(
+    const double seedIndex[3], const double seedWorld[3], double radius, double minStep) = 0;
+  /// See SurfaceGrowth.
+  virtual int GrowFromKey(std::int64_t key) = 0;
+  virtual void GrowAll() = 0;
+  virtual void GrowBoundary() = 0;
+  virtual void SetCrossRanks(bool cross) = 0;
+  virtual void SetBudget(std::int64_t budget) = 0;
+  virtual bool Busy() const = 0;
+  virtual void Continue() = 0;
+  virtual std::vector<Departure> TakeDepartures() = 0;
+  virtual void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels) = 0;
+  virtual std::int64_t CubesExamined() const = 0;
+  virtual std::int64_t PlanePointsRead() const = 0;
+  /// Makes the triangles of every node found (SurfaceExtraction).
+  virtual void Extract() = 0;
+
+  virtual LocalMesh& Mesh() = 0;
+  virtual std::vector<Port>& Ports() = 0;
+  virtual ComponentSet& Components() = 0;
+
+  virtual std::string Error() const = 0;
+  virtual bool Aborted() const = 0;
+  virtual bool MissingGhosts() const = 0;
+};
+
 template <typename Values>
-class SurfaceKernel
+class SurfaceKernel : public Kernel
 {
 public:
   SurfaceKernel(const CaseTable& table, const Grid& grid, const Ownership& ownership,
     const Values& values, const SurfaceOptions& options)
     : Volume(table, grid, ownership, values, options)
-    , Growth(this->Volume, this->Components)
-    , Extraction(this->Volume, this->Components)
+    , Growth(this->Volume, this->Found)
+    , Extraction(this->Volume, this->Found)
   {
   }
 
-  /// See rgmc::NearestVertex.
   SeedHit NearestVertex(
-    const double seedIndex[3], const double seedWorld[3], double radius, double minStep)
+    const double seedIndex[3], const double seedWorld[3], double radius, double minStep) override
   {
     return rgmc::NearestVertex(this->Volume, seedIndex, seedWorld, radius, minStep);
   }
-  /// See SurfaceGrowth.
-  int GrowFromKey(std::int64_t key) { return this->Growth.GrowFromKey(key); }
-  void GrowAll() { this->Growth.GrowAll(); }
-  void GrowBoundary() { this->Growth.GrowBoundary(); }
-  void SetCrossRanks(bool cross) { this->Growth.CrossRanks = cross; }
-  void SetBudget(std::int64_t budget) { this->Growth.SetBudget(budget); }
-  bool Busy() const { return this->Growth.Busy(); }
-  void Continue() { this->Growth.Continue(); }
-  std::vector<Departure> TakeDepartures() { return this->Growth.TakeDepartures(); }
-  void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels)
+  int GrowFromKey(std::int64_t key) override { return this->Growth.GrowFromKey(key); }
+  void GrowAll() override { this->Growth.GrowAll(); }
+  void GrowBoundary() override { this->Growth.GrowBoundary(); }
+  void SetCrossRanks(bool cross) override { this->Growth.CrossRanks = cross; }
+  void SetBudget(std::int64_t budget) override { this->Growth.SetBudget(budget); }
+  bool Busy() const override { return this->Growth.Busy(); }
+  void Continue() override { this->Growth.Continue(); }
+  std::vector<Departure> TakeDepartures() override { return this->Growth.TakeDepartures(); }
+  void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels) override
   {
     this->Growth.GrowFromArrivals(arrivals, numLabels);
   }
-  std::int64_t CubesExamined() const { return this->Growth.CubesExamined(); }
-  std::int64_t PlanePointsRead() const { return this->Growth.PlanePointsRead(); }
-  /// Makes the triangles of every node found (SurfaceExtraction).
-  void Extract() { this->Extraction.Extract(this->Growth.Nodes()); }
+  std::int64_t CubesExamined() const override { return this->Growth.CubesExamined(); }
+  std::int64_t PlanePointsRead() const override { return this->Growth.PlanePointsRead(); }
+  void Extract() override { this->Extraction.Extract(this->Growth.Nodes()); }
 
-  LocalMesh& Mesh() { return this->Extraction.Mesh; }
-  std::vector<Port>& Ports() { return this->Extraction.Ports; }
-  ComponentSet Components;
+  LocalMesh& Mesh() override { return this->Extraction.Mesh; }
+  std::vector<Port>& Ports() override { return this->Extraction.Ports; }
+  ComponentSet& Components() override { return this->Found; }
   std::int64_t Joins() const { return this->Extraction.Joins(); }
   std::int64_t NumberOfNodes() { return static_cast<std::int64_t>(this->Growth.Nodes().size()); }
 
-  std::string Error() const { return this->Volume.Error(); }
-  bool Aborted() const { return this->Volume.Aborted(); }
-  bool MissingGhosts() const { return this->Volume.MissingGhosts(); }
+  std::string Error() const override { return this->Volume.Error(); }
+  bool Aborted() const override { return this->Volume.Aborted(); }
+  bool MissingGhosts() const override { return this->Volume.MissingGhosts(); }
 
 private:
+  ComponentSet Found; // the components of the surface found (before the passes that fill it)
   SampledVolume<Values> Volume;
   SurfaceGrowth<Values> Growth;
   SurfaceExtraction<Values> Extraction;

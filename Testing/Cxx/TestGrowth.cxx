@@ -162,12 +162,12 @@ void TwoBlobs()
     g.GrowAll();
     g.Extract();
     int roots = 0;
-    for (int c = 0; c < g.Components.Size(); ++c)
+    for (int c = 0; c < g.Components().Size(); ++c)
     {
-      if (g.Components.Root(c) == c)
+      if (g.Components().Root(c) == c)
       {
         ++roots;
-        RGMC_CHECK(g.Components.TotalsOf(c).Triangles == 8, "each blob has 8 triangles");
+        RGMC_CHECK(g.Components().TotalsOf(c).Triangles == 8, "each blob has 8 triangles");
       }
     }
     RGMC_CHECK(roots == 2, "two components, not " << roots);

@@ -147,10 +147,10 @@ Result Run(const std::vector<float>& values, Mode mode, int owners, int owner, i
     r.Add(&p.Key, 1);
     r.Add(&p.Component, 1);
   }
-  for (int c = 0; c < kernel.Components.Size(); ++c)
+  for (int c = 0; c < kernel.Components().Size(); ++c)
   {
-    const int root = kernel.Components.Root(c);
-    const rgmc::ComponentSet::Totals& t = kernel.Components.TotalsOf(root);
+    const int root = kernel.Components().Root(c);
+    const rgmc::ComponentSet::Totals& t = kernel.Components().TotalsOf(root);
     r.Add(&root, 1);
     r.Add(&t.Triangles, 1);
     r.Add(&t.MinKey, 1);
