@@ -51,7 +51,7 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--size", type=int, default=96)
     args = parser.parse_args()
-    simple.LoadPlugin(args.plugin, ns=vars(simple))
+    simple.LoadPlugin(os.path.abspath(args.plugin), ns=vars(simple))  # 5.13+: no relative path
     controller = servermanager.vtkProcessModule.GetProcessModule().GetGlobalController()
     rank, ranks = controller.GetLocalProcessId(), controller.GetNumberOfProcesses()
     os.makedirs(args.out, exist_ok=True)
