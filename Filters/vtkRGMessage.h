@@ -108,8 +108,6 @@ public:
     return value;
   }
   bool Ok() const { return this->Good; }
-  /// Whether every word has been read.
-  bool AtEnd() const { return this->At == this->Count; }
   /// Where the reader is: the words read so far.
   std::size_t Position() const { return this->At; }
 
