@@ -604,21 +604,71 @@ private:
   }
 
   /// Finds every node of tile `tile`, each unfound one starting a new component (numbered from
-  /// 0 in the tile) grown inside the tile only. Returns the number of components.
+  /// 0 in the tile) grown inside the tile only, in k, j, i order of the cubes. Returns the
+  /// number of components.
+  ///
+  /// Most cubes of a volume have no surface: the tile's grid points are classified first, a row
+  /// at a time (ClassifyRow: each sample read once), and only the cubes whose corners are not
+  /// all on one side of the isovalue (cases other than 0 and 255), or that touch a NaN sample
+  /// (for Evaluate to report it), are evaluated one by one.
   int ScanTile(std::int64_t tile)
   {
     SampledVolume<Values>& volume = this->Volume;
     TileWork& w = this->Work[tile];
     const CellBox box = this->TileBox(tile);
+    const bool holes = !volume.Owned.Overlaps().empty();
+    const int cubesPerRow = box.Hi[0] - box.Lo[0] + 1; // at most TileCubes
+    const int pointsPerRow = cubesPerRow + 1;
+    const int rows = box.Hi[1] - box.Lo[1] + 2;
+    const std::uint64_t rowCubes = (std::uint64_t(1) << cubesPerRow) - 1;
+    // The classified rows of grid points of the planes below and above the current slab.
+    std::uint64_t above[2][TileCubes + 1], notNumber[2][TileCubes + 1];
+    auto classifyPlane = [&](int side, int k)
+    {
+      for (int r = 0; r < rows; ++r)
+      {
+        volume.ClassifyRow(
+          box.Lo[0], pointsPerRow, box.Lo[1] + r, k, above[side][r], notNumber[side][r]);
+      }
+    };
+    classifyPlane(0, box.Lo[2]);
     CubeSamples st;
     CubeSurface surface;
     int components = 0;
-    for (int k = box.Lo[2]; k <= box.Hi[2] && !volume.Stopped(); ++k)
+    for (int k = box.Lo[2], lower = 0; k <= box.Hi[2] && !volume.Stopped(); ++k, lower ^= 1)
     {
-      for (int j = box.Lo[1]; j <= box.Hi[1]; ++j)
+      const int upper = lower ^ 1;
+      classifyPlane(upper, k + 1);
+      for (int j = box.Lo[1]; j <= box.Hi[1] && !volume.Stopped(); ++j)
       {
-        for (int i = box.Lo[0]; i <= box.Hi[0] && !volume.Stopped(); ++i)
+        const int r = j - box.Lo[1];
+        // A cube is cut when its 8 corners are neither all above nor all below; the 4 rows of
+        // points around the row of cubes, then each cube's two ends along i.
+        std::uint64_t all =
+          above[lower][r] & above[lower][r + 1] & above[upper][r] & above[upper][r + 1];
+        std::uint64_t any =
+          above[lower][r] | above[lower][r + 1] | above[upper][r] | above[upper][r + 1];
+        std::uint64_t nan = notNumber[lower][r] | notNumber[lower][r + 1] | notNumber[upper][r] |
+          notNumber[upper][r + 1];
+        all &= all >> 1;
+        any |= any >> 1;
+        nan |= nan >> 1;
+        std::uint64_t candidates = ((any & ~all) | nan) & rowCubes;
+        // The cubes skipped were read too (examined), as long as they are this rank's.
+        if (!holes)
         {
+          w.Examined += cubesPerRow - __builtin_popcountll(candidates);
+        }
+        else
+        {
+          for (std::uint64_t rest = rowCubes & ~candidates; rest; rest &= rest - 1)
+          {
+            w.Examined += volume.Owned.Owns(box.Lo[0] + __builtin_ctzll(rest), j, k);
+          }
+        }
+        for (; candidates; candidates &= candidates - 1)
+        {
+          const int i = box.Lo[0] + __builtin_ctzll(candidates);
           if (!volume.Owned.Owns(i, j, k))
           {
             continue;
