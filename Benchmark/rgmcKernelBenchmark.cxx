@@ -12,6 +12,8 @@
 // Minimum of the repeats; JSON on stdout, a summary on stderr.
 //
 //   rgmcKernelBenchmark [--size 512] [--ct-size 384] [--threads 1,2] [--repeats 5]
+//                       [--only seeded|all]
+// --only runs the kernel's stages of one mode and nothing else (for a profiler: perf record).
 #include "rgmcBenchmark.h"
 
 #include "rgmcSurfaceKernel.h"
@@ -269,6 +271,7 @@ int main(int argc, char* argv[])
 {
   int size = 512, ctSize = 384, repeats = 5;
   std::vector<int> threadCounts = { 1, 2 };
+  std::string only;
   for (int a = 1; a + 1 < argc; a += 2)
   {
     const std::string arg = argv[a];
@@ -284,6 +287,11 @@ int main(int argc, char* argv[])
     {
       repeats = std::atoi(argv[a + 1]);
     }
+    else if (arg == "--only" &&
+      (std::string(argv[a + 1]) == "seeded" || std::string(argv[a + 1]) == "all"))
+    {
+      only = argv[a + 1];
+    }
     else if (arg == "--threads")
     {
       threadCounts.clear();
@@ -296,7 +304,7 @@ int main(int argc, char* argv[])
     else
     {
       std::cerr << "usage: rgmcKernelBenchmark [--size N] [--ct-size N] [--threads 1,2] "
-                   "[--repeats N]\n";
+                   "[--repeats N] [--only seeded|all]\n";
       return 2;
     }
   }
@@ -327,6 +335,14 @@ int main(int argc, char* argv[])
       vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
         [&]()
         {
+          if (!only.empty())
+          {
+            const Stages stages = KernelStages(v, only == "seeded", repeats);
+            std::cerr << v.Name << ", " << threads << " thread(s), " << only << ": seed "
+                      << stages.Seed << " s, growth " << stages.Growth << " s, extraction "
+                      << stages.Extraction << " s, " << stages.Triangles << " triangles\n";
+            return;
+          }
           long long feTriangles = 0, seededTriangles = 0, largestTriangles = 0, allTriangles = 0;
           const double fe = FlyingEdgesSeconds(v, repeats, feTriangles);
           const Stages seededStages = KernelStages(v, true, repeats);

@@ -135,6 +135,44 @@ constexpr std::array<int, 12> CubeEdgeAxes()
 }
 constexpr std::array<int, 12> CubeEdgeAxis = CubeEdgeAxes();
 
+/// One of the 3 other cubes around a cube's edge: its offset from the cube and its edge there.
+struct EdgeNeighbour
+{
+  std::int8_t Offset[3];
+  std::int8_t Edge;
+};
+
+/// For each cube edge, the 3 other cubes around it, in ForCubesAround's order (so that growth
+/// visits them in the same order whichever way it steps).
+constexpr std::array<std::array<EdgeNeighbour, 3>, 12> EdgeNeighbours()
+{
+  std::array<std::array<EdgeNeighbour, 3>, 12> table{};
+  for (int e = 0; e < 12; ++e)
+  {
+    const int axis = CubeEdgeAxis[e];
+    const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+    const int* p = CornerOffset[EdgeCorners[e][0]]; // the edge's lower end, from the cube
+    int n = 0;
+    for (int d = 0; d < 8; ++d)
+    {
+      const int o[3] = { d & 1, (d >> 1) & 1, (d >> 2) & 1 };
+      const int offset[3] = { p[0] - o[0], p[1] - o[1], p[2] - o[2] };
+      if (o[axis] != 0 || (offset[0] == 0 && offset[1] == 0 && offset[2] == 0))
+      {
+        continue;
+      }
+      EdgeNeighbour& nb = table[e][n++];
+      for (int a = 0; a < 3; ++a)
+      {
+        nb.Offset[a] = static_cast<std::int8_t>(offset[a]);
+      }
+      nb.Edge = static_cast<std::int8_t>(CubeEdgeAtTable[axis][o[u]][o[v]]);
+    }
+  }
+  return table;
+}
+constexpr std::array<std::array<EdgeNeighbour, 3>, 12> EdgeNeighbourTable = EdgeNeighbours();
+
 /// Calls f(i, j, k, edge) for each cube that contains the vertex at grid point p: the 4 cubes
 /// around the edge leaving p along `axis` (edge: that cube's edge carrying it), or the 8 cubes
 /// around p when axis < 0 (edge -1). Cubes outside the volume are included: callers check.
