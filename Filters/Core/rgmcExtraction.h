@@ -221,6 +221,7 @@ public:
 private:
   static constexpr int ChunkSlabs = 16;     // slabs of cubes per chunk (not per thread)
   static constexpr int ChunksPerReport = 8; // chunks between progress reports
+  static constexpr int PrefetchAhead = 8;   // nodes between a prefetch and the node's use
 
   /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
   /// reset cheaply).
@@ -349,6 +350,11 @@ private:
       work.SlabK = box.Lo[2] + s;
       for (std::int64_t n = start[s]; n < start[s + 1]; ++n)
       {
+        if (n + PrefetchAhead < start[s + 1])
+        {
+          const SurfaceNode& ahead = nodes[n + PrefetchAhead];
+          this->Volume.PrefetchAround(ahead.I, ahead.J, ahead.K);
+        }
         const SurfaceNode& node = nodes[n];
         if (this->Volume.Evaluate(node.I, node.J, node.K, st))
         {
@@ -456,11 +462,50 @@ private:
       st.S[EdgeCorners[v.Edge][1]], n.Component, layer, index);
   }
 
+  /// The output point of the vertex on edge e of a cube without a degenerate sample: its slot
+  /// found from the cube's place in the edge layers (`at`) and the edge, the vertex itself
+  /// (its key) made only when it is new.
+  RGMC_INLINE std::int32_t EdgeVertex(ChunkWork& work, const SurfaceNode& n, int e, std::int32_t at,
+    const CubeSamples& st, const CubeSurface& surface)
+  {
+    const int* o = CornerOffset[EdgeCorners[e][0]];
+    const int axis = CubeEdgeAxis[e];
+    EdgeLayer* layer = axis == 2 ? work.VerticalLayer : work.SlabLayers[o[2]][axis];
+    const std::int32_t index = at + o[0] + static_cast<std::int32_t>(this->LayerNx) * o[1];
+    std::int32_t& slot = layer->Ids[index];
+    if (slot > 0)
+    {
+      return this->UseVertex(work, slot, SurfaceVertex(), 0.0, 0.0, n.Component, layer, index);
+    }
+    return this->UseVertex(work, slot, surface.EdgeVertex(e), st.S[EdgeCorners[e][0]],
+      st.S[EdgeCorners[e][1]], n.Component, layer, index);
+  }
+
   /// Emits the triangles of one node.
   void Emit(
     ChunkWork& work, const SurfaceNode& n, const CubeSamples& st, const CubeSurface& surface)
   {
     LocalMesh& m = work.Out->Mesh;
+    if (!surface.Degenerate())
+    {
+      // The common case: the case table's triangles of the node's sheet.
+      const CaseEntry& entry = this->Volume.Table[n.Case];
+      const std::int32_t at = static_cast<std::int32_t>(
+        (n.I - this->NodeBox.Lo[0]) + this->LayerNx * (n.J - this->NodeBox.Lo[1]));
+      for (int t = 0; t < entry.NumTriangles; ++t)
+      {
+        if (entry.TriangleSheet[t] == n.Node)
+        {
+          const std::int32_t ids[3] = { this->EdgeVertex(
+                                          work, n, entry.Triangles[t][0], at, st, surface),
+            this->EdgeVertex(work, n, entry.Triangles[t][1], at, st, surface),
+            this->EdgeVertex(work, n, entry.Triangles[t][2], at, st, surface) };
+          m.Triangles.append(ids, 3);
+          m.TriangleComponent.push_back(n.Component);
+        }
+      }
+      return;
+    }
     surface.ForEachTriangle(n.Node,
       [&](const SurfaceVertex* triangle)
       {

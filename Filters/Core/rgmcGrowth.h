@@ -264,8 +264,9 @@ private:
     std::int64_t Examined = 0; // cubes whose samples Visit read
   };
 
-  static constexpr int TileCubes = 32;  // cubes along each axis of a tile
-  static constexpr int TileWords = 512; // 64-bit words of found-bits in a tile (32^3 bits)
+  static constexpr int TileCubes = 32;    // cubes along each axis of a tile
+  static constexpr int PrefetchAhead = 8; // queued nodes between a prefetch and the expansion
+  static constexpr int TileWords = 512;   // 64-bit words of found-bits in a tile (32^3 bits)
 
   RGMC_INLINE std::int64_t TileOf(int i, int j, int k) const
   {
@@ -476,6 +477,12 @@ private:
     TileWork& w = this->Work[tile];
     for (; head < w.Queue.size() && !this->Volume.Stopped(); ++head)
     {
+      if (head + PrefetchAhead < w.Queue.size())
+      {
+        // The samples of the cubes around a node soon expanded (those its edges touch).
+        const SurfaceNode& ahead = w.Queue[head + PrefetchAhead];
+        this->Volume.PrefetchAround(ahead.I, ahead.J, ahead.K);
+      }
       const SurfaceNode n = w.Queue[head];
       this->Expand(tile, n, keepInTile);
     }
