@@ -1,0 +1,284 @@
+// The kernel's shortcuts against what they stand for, without VTK's filters:
+//   - ClassifyRow (the full scan's classification of grid points) against Evaluate's case bits
+//     and its NaN test, on every row, start and length of float and int16 fields;
+//   - EdgeNeighbourTable (growth's fixed steps to the cubes around an edge) against
+//     ForCubesAround, in the same order, and the neighbour's edge being the same edge;
+//   - the full scan (GrowAll) finding exactly the cubes that have surface nodes, counted by
+//     brute force over every cube (Evaluate + Describe), on volumes cut into partial tiles, with
+//     samples equal to the isovalue, and on a piece whose cubes overlap a lower rank's;
+//   - a NaN sample away from the surface (in a region the scan classifies as empty) still
+//     reported by the full scan, naming its grid point.
+#include "rgmcCheck.h"
+#include "rgmcSurfaceKernel.h"
+
+#include "vtkMarchingCubesTriangleCases.h"
+
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <limits>
+#include <set>
+#include <tuple>
+#include <vector>
+
+namespace
+{
+
+const rgmc::CaseTable& Table()
+{
+  static const rgmc::CaseTable table(&vtkMarchingCubesTriangleCases::GetCases()[0].edges[0]);
+  return table;
+}
+
+/// A fixed pseudo-random sequence.
+struct Random
+{
+  std::uint64_t State = 12345;
+  double Next()
+  {
+    this->State = this->State * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(this->State >> 11) / 9007199254740992.0;
+  }
+};
+
+/// Blobs rounded to integers (many samples equal the isovalue 3), with a few NaN when asked.
+template <typename T>
+std::vector<T> Field(const int n[3], bool withNaN)
+{
+  std::vector<T> values(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+  Random random;
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i = 0; i < n[0]; ++i)
+      {
+        const double v =
+          5 * std::sin(0.31 * i) * std::cos(0.23 * j) + 4 * std::sin(0.19 * k) + 2 * random.Next();
+        values[i + n[0] * (j + n[1] * static_cast<std::size_t>(k))] = static_cast<T>(std::round(v));
+      }
+    }
+  }
+  if (withNaN)
+  {
+    for (int c = 0; c < 20; ++c)
+    {
+      values[static_cast<std::size_t>(random.Next() * values.size())] =
+        std::numeric_limits<T>::quiet_NaN();
+    }
+  }
+  return values;
+}
+
+template <typename T>
+void CheckClassifyRow(const char* what, bool withNaN)
+{
+  const int n[3] = { 70, 9, 7 };
+  const std::vector<T> values = Field<T>(n, withNaN);
+  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
+  const rgmc::Grid grid(whole, whole);
+  const rgmc::Ownership own({ grid.WholeCells() }, 0);
+  rgmc::SurfaceOptions options;
+  options.Isovalue = 3.0;
+  rgmc::SampledVolume<std::vector<T>> volume(Table(), grid, own, values, options);
+  int rows = 0;
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i0 = 0; i0 < n[0]; ++i0)
+      {
+        for (int length = 1; length <= 64 && i0 + length <= n[0]; ++length)
+        {
+          std::uint64_t above = ~std::uint64_t(0), notNumber = ~std::uint64_t(0);
+          volume.ClassifyRow(i0, length, j, k, above, notNumber);
+          std::uint64_t wantAbove = 0, wantNaN = 0;
+          for (int b = 0; b < length; ++b)
+          {
+            const double s = static_cast<double>(values[grid.LocalIndex(i0 + b, j, k)]);
+            wantAbove |= static_cast<std::uint64_t>(s >= options.Isovalue) << b;
+            wantNaN |= static_cast<std::uint64_t>(s != s) << b;
+          }
+          RGMC_CHECK(above == wantAbove && notNumber == wantNaN,
+            what << ": row j " << j << " k " << k << " from i " << i0 << ", " << length
+                 << " points: classified " << above << "/" << notNumber << ", expected "
+                 << wantAbove << "/" << wantNaN);
+          ++rows;
+        }
+      }
+    }
+  }
+  // The case bits of every cube from its rows, as the scan combines them, against Evaluate.
+  for (int k = 0; k + 1 < n[2]; ++k)
+  {
+    for (int j = 0; j + 1 < n[1]; ++j)
+    {
+      std::uint64_t a[4], x[4];
+      for (int r = 0; r < 4; ++r)
+      {
+        volume.ClassifyRow(0, 64, j + (r & 1), k + (r >> 1), a[r], x[r]);
+      }
+      for (int i = 0; i < 63; ++i)
+      {
+        int code = 0;
+        for (int v = 0; v < 8; ++v)
+        {
+          const int* o = rgmc::CornerOffset[v];
+          code |= static_cast<int>((a[o[1] + 2 * o[2]] >> (i + o[0])) & 1) << v;
+        }
+        bool nan = false;
+        for (int r = 0; r < 4; ++r)
+        {
+          nan = nan || ((x[r] >> i) & 3);
+        }
+        rgmc::CubeSamples st;
+        rgmc::SampledVolume<std::vector<T>> fresh(Table(), grid, own, values, options);
+        const bool read = fresh.Evaluate(i, j, k, st);
+        RGMC_CHECK(read != nan,
+          what << ": cube " << i << " " << j << " " << k << ": Evaluate "
+               << (read ? "read it" : "met a NaN") << ", the rows say "
+               << (nan ? "NaN" : "no NaN"));
+        RGMC_CHECK(!read || code == st.Case,
+          what << ": cube " << i << " " << j << " " << k << ": case " << st.Case
+               << " from Evaluate, " << code << " from the rows");
+      }
+    }
+  }
+  std::cout << what << ": " << rows << " rows classified\n";
+}
+
+void CheckEdgeNeighbours()
+{
+  const int whole[6] = { 0, 20, 0, 20, 0, 20 };
+  const rgmc::Grid grid(whole, whole);
+  const int cube[3] = { 5, 6, 7 };
+  for (int e = 0; e < 12; ++e)
+  {
+    const int* lo = rgmc::CornerOffset[rgmc::EdgeCorners[e][0]];
+    const int p[3] = { cube[0] + lo[0], cube[1] + lo[1], cube[2] + lo[2] };
+    const int axis = rgmc::CaseTable::EdgeAxis(e);
+    std::vector<std::tuple<int, int, int, int>> around;
+    rgmc::ForCubesAround(p, axis,
+      [&](int i, int j, int k, int edge)
+      {
+        if (i != cube[0] || j != cube[1] || k != cube[2])
+        {
+          around.emplace_back(i, j, k, edge);
+        }
+      });
+    RGMC_CHECK(around.size() == 3, "edge " << e << ": " << around.size() << " other cubes");
+    for (std::size_t n = 0; n < around.size() && n < 3; ++n)
+    {
+      const rgmc::EdgeNeighbour& nb = rgmc::EdgeNeighbourTable[e][n];
+      const int at[3] = { cube[0] + nb.Offset[0], cube[1] + nb.Offset[1], cube[2] + nb.Offset[2] };
+      RGMC_CHECK(std::make_tuple(at[0], at[1], at[2], int(nb.Edge)) == around[n],
+        "edge " << e << ", neighbour " << n << ": the table steps to " << at[0] << " " << at[1]
+                << " " << at[2] << " edge " << int(nb.Edge) << ", ForCubesAround gives "
+                << std::get<0>(around[n]) << " " << std::get<1>(around[n]) << " "
+                << std::get<2>(around[n]) << " edge " << std::get<3>(around[n]));
+      // The neighbour's edge is the same edge of the grid: the same key.
+      const int* nlo = rgmc::CornerOffset[rgmc::EdgeCorners[nb.Edge][0]];
+      RGMC_CHECK(grid.EdgeKey(at[0] + nlo[0], at[1] + nlo[1], at[2] + nlo[2],
+                   rgmc::CaseTable::EdgeAxis(nb.Edge)) == grid.EdgeKey(p[0], p[1], p[2], axis),
+        "edge " << e << ", neighbour " << n << ": not the same edge of the grid");
+    }
+  }
+}
+
+/// The full scan on `owner` of `boxes`, against a brute-force count of the owned cubes that
+/// have nodes.
+void CheckScan(const char* what, const int n[3], const std::vector<rgmc::CellBox>& boxes, int owner)
+{
+  const std::vector<float> values = Field<float>(n, false);
+  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
+  const rgmc::Grid grid(whole, whole);
+  const rgmc::Ownership own(boxes, owner);
+  rgmc::SurfaceOptions options;
+  options.Isovalue = 3.0;
+  rgmc::SampledVolume<std::vector<float>> volume(Table(), grid, own, values, options);
+  rgmc::ComponentSet components;
+  rgmc::SurfaceGrowth<std::vector<float>> growth(volume, components);
+  growth.GrowAll();
+  std::set<std::tuple<int, int, int, int>> found;
+  std::size_t duplicates = 0;
+  for (const rgmc::SurfaceNode& node : growth.Nodes())
+  {
+    duplicates += !found.emplace(node.I, node.J, node.K, node.Node).second;
+  }
+  std::set<std::tuple<int, int, int, int>> expected;
+  rgmc::CubeSamples st;
+  rgmc::CubeSurface surface;
+  std::size_t degenerate = 0;
+  for (int k = 0; k + 1 < n[2]; ++k)
+  {
+    for (int j = 0; j + 1 < n[1]; ++j)
+    {
+      for (int i = 0; i + 1 < n[0]; ++i)
+      {
+        if (!own.Owns(i, j, k) || !volume.Evaluate(i, j, k, st))
+        {
+          continue;
+        }
+        volume.Describe(i, j, k, st, surface);
+        degenerate += st.Degenerate;
+        for (int node = 0; node < surface.NumberOfNodes(); ++node)
+        {
+          expected.emplace(i, j, k, node);
+        }
+      }
+    }
+  }
+  RGMC_CHECK(duplicates == 0, what << ": " << duplicates << " nodes found twice");
+  RGMC_CHECK(found == expected,
+    what << ": the scan found " << found.size() << " nodes, " << expected.size() << " expected");
+  RGMC_CHECK(degenerate > 0, what << ": no cube with a sample equal to the isovalue");
+  std::cout << what << ": " << found.size() << " nodes, " << degenerate
+            << " cubes with a sample on the isovalue\n";
+}
+
+void CheckNaNAwayFromSurface()
+{
+  const int n[3] = { 50, 40, 36 };
+  for (const float level : { -5.0f, 10.0f }) // all below, all above the isovalue
+  {
+    std::vector<float> values(static_cast<std::size_t>(n[0]) * n[1] * n[2], level);
+    // A small surface far from the NaN, so that the scan has work elsewhere.
+    values[3 + n[0] * (3 + n[1] * 3)] = level < 0 ? 10.0f : -5.0f;
+    values[40 + n[0] * (33 + n[1] * 30)] = std::numeric_limits<float>::quiet_NaN();
+    const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
+    const rgmc::Grid grid(whole, whole);
+    const rgmc::Ownership own({ grid.WholeCells() }, 0);
+    rgmc::SurfaceOptions options;
+    options.Isovalue = 3.0;
+    rgmc::SurfaceKernel<std::vector<float>> kernel(Table(), grid, own, values, options);
+    kernel.GrowAll();
+    const std::string error = kernel.Error();
+    RGMC_CHECK(error.find("(40, 33, 30) is NaN") != std::string::npos,
+      "a NaN in a region " << (level < 0 ? "below" : "above") << " the isovalue: the scan says '"
+                           << error << "'");
+  }
+}
+
+} // namespace
+
+int main()
+{
+  CheckClassifyRow<float>("float samples with NaN", true);
+  CheckClassifyRow<short>("int16 samples", false);
+  CheckEdgeNeighbours();
+  // Partial tiles (70 = 2 x 32 + 6 points), more than one tile along each axis.
+  const int n[3] = { 70, 45, 38 };
+  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
+  const rgmc::CellBox all = rgmc::Grid(whole, whole).WholeCells();
+  CheckScan("one owner", n, { all }, 0);
+  // A piece whose box overlaps a lower rank's (the holes of a reader that ignores pieces):
+  // rank 1 owns its box minus rank 0's.
+  rgmc::CellBox lower = all, upper = all;
+  lower.Hi[0] = 40;
+  upper.Lo[0] = 20;
+  upper.Lo[1] = 3;
+  CheckScan("overlapping boxes, rank 0", n, { lower, upper }, 0);
+  CheckScan("overlapping boxes, rank 1", n, { lower, upper }, 1);
+  CheckNaNAwayFromSurface();
+  return rgmc_test::Result("TestKernelShortcuts");
+}
