@@ -31,6 +31,17 @@ otherwise; the backend that ran is recorded): vtkFlyingEdges3D, our seeded and a
 modes, Seam Repair with 20 Laplacian iterations, and whether the outputs are bitwise the same at
 every thread count. Writes threads.md and threads.json.
 
+  python3 Scripts/rgmc_evaluate.py --kernel   # or: ./rgmc evaluate --kernel
+
+The kernel benchmark instead: the build's rgmcKernelBenchmark program, one rank, at 1 and 2
+threads (STDThread): the CT phantom (512^3, seeded on the skull) and a noisy CT-like head made
+by the program (384^3 int16, a skull shell, a separate head holder, noise of about 40 HU), each
+in Seeded, Largest Component and All Components mode against vtkFlyingEdges3D in the same run,
+with the kernel's stages (seed search, growth, extraction, the rest of the filter) in ns per
+output triangle; then the GUI's case, Scripts/rgmc_slider.py in pvpython: the median time from
+a new Isovalue to the updated seeded surface over 20 changes, against ParaView's Contour, with
+pvpython's own threads and with 2 STDThread threads. Writes kernel.md and kernel.json.
+
   python3 Scripts/rgmc_evaluate.py --ranks-benchmark   # or: ./rgmc evaluate --ranks-benchmark
 
 The ranks benchmark instead: the build's rgmcRanks program on 1, 2 and 4 ranks (--ranks): a
@@ -432,6 +443,90 @@ def threads_report(result, args):
     return "\n".join(lines) + "\n"
 
 
+def run_kernel(args):
+    command = [args.kernel_binary, "--size", str(args.threads_size), "--ct-size",
+               str(args.kernel_ct_size), "--threads", args.thread_counts, "--repeats",
+               str(args.kernel_repeats)]
+    print("+ " + " ".join(command), flush=True)
+    process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
+    if process.returncode != 0:
+        raise rgmc_common.UsageError("rgmcKernelBenchmark failed (exit %d)" % process.returncode)
+    result = json.loads(process.stdout)
+    result["slider"] = []
+    plugin = rgmc_common.find_plugin()
+    if args.slider_changes > 0 and plugin:
+        script = os.path.join(rgmc_common.ROOT, "Scripts", "rgmc_slider.py")
+        for threads in (None, 2):
+            env = dict(os.environ)
+            if threads:
+                env.update(VTK_SMP_BACKEND_IN_USE="STDThread", VTK_SMP_MAX_THREADS=str(threads))
+            command = ["pvpython", script, "--plugin", plugin, "--size", str(args.threads_size),
+                       "--changes", str(args.slider_changes)]
+            print("+ %s%s" % ("VTK_SMP_BACKEND_IN_USE=STDThread VTK_SMP_MAX_THREADS=%d " % threads
+                              if threads else "", " ".join(command)), flush=True)
+            process = subprocess.run(command, stdout=subprocess.PIPE, text=True, env=env)
+            if process.returncode != 0:
+                raise rgmc_common.UsageError("rgmc_slider.py failed (exit %d)" % process.returncode)
+            result["slider"].append(json.loads(process.stdout.strip().splitlines()[-1]))
+    return result
+
+
+def kernel_report(result, args):
+    runs = result["runs"]
+    lines = ["# RGMC kernel benchmark", "",
+             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
+             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+             "One rank, vtkSMPTools' STDThread backend. Minimum of %d runs. Seeded: from one seed "
+             "on the skull; the stages are the kernel's (rgmc::SurfaceKernel on the image's "
+             "samples), 'rest' is the filter's time minus the stages (input checks, the decision, "
+             "the output arrays; a difference of two minima, so within noise of 0). FE: "
+             "vtkFlyingEdges3D with normals, the same isovalue." % result["repeats"], "",
+             "| volume | threads | FE (s) | seeded (s) | seeded / FE | seeded ns/triangle: seed, "
+             "growth, extraction, rest = total | Largest (s) | Largest / FE | All (s) | All / FE |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in runs:
+        ns = r["seeded_ns_per_triangle"]
+        lines.append("| %s | %d | %.3f | %.3f | %.2f | %.1f, %.1f, %.1f, %.1f = %.1f | %.3f | %.2f | "
+                     "%.3f | %.2f |" % (
+                         r["volume"], r["threads"], r["flying_edges"], r["seeded"],
+                         r["seeded_vs_flying_edges"], ns["seed"], ns["growth"], ns["extraction"],
+                         ns["rest"], ns["total"], r["largest"], r["largest_vs_flying_edges"],
+                         r["all"], r["all_vs_flying_edges"]))
+    lines += ["", "Triangles: " + "; ".join(
+        "%s: FE %d, seeded %d, All %d, FE %.0f ns/triangle" % (
+            r["volume"], r["flying_edges_triangles"], r["seeded_triangles"], r["all_triangles"],
+            r["flying_edges_ns_per_triangle"]) for r in runs if r["threads"] == runs[0]["threads"]), ""]
+    if result.get("slider"):
+        lines += ["The GUI's case (Scripts/rgmc_slider.py in pvpython, the phantom at %d^3): the time "
+                  "from a new Isovalue to the updated surface, median of %d changes between 300 and "
+                  "500 HU:" % (result["slider"][0]["size"], result["slider"][0]["changes"]), ""]
+        for s in result["slider"]:
+            lines.append("- %d thread%s (%s): RGMC seeded %.3f s (%.3f to %.3f), ParaView Contour "
+                         "%.3f s" % (s["threads"], "s" if s["threads"] > 1 else "", s["backend"],
+                                     s["rgmc_seeded"]["median_s"], s["rgmc_seeded"]["min_s"],
+                                     s["rgmc_seeded"]["max_s"], s["paraview_contour"]["median_s"]))
+        lines.append("")
+    lines += ["Targets (issue 22), met or not:", ""]
+    for r in runs:
+        what = "%s, %d thread%s" % (r["volume"], r["threads"], "s" if r["threads"] > 1 else "")
+        for key, limit in (("seeded_vs_flying_edges", 0.1), ("largest_vs_flying_edges", 1.2),
+                           ("all_vs_flying_edges", 1.0)):
+            lines.append("- %s: %s <= %.1f: %.2f, %s" % (
+                what, key.replace("_vs_flying_edges", " / FE"), limit, r[key],
+                "met" if r[key] <= limit else "NOT met"))
+    for r in runs:
+        if r["volume"].startswith("phantom512"):
+            limit = 0.10 if r["threads"] == 1 else 0.06
+            lines.append("- phantom 512^3 seeded, %d thread%s: <= %.2f s: %.3f s, %s" % (
+                r["threads"], "s" if r["threads"] > 1 else "", limit, r["seeded"],
+                "met" if r["seeded"] <= limit else "NOT met"))
+    for s in result.get("slider", []):
+        lines.append("- the slider, %d thread%s: <= 0.1 s: %.3f s, %s" % (
+            s["threads"], "s" if s["threads"] > 1 else "", s["rgmc_seeded"]["median_s"],
+            "met" if s["rgmc_seeded"]["median_s"] <= 0.1 else "NOT met"))
+    return "\n".join(lines) + "\n"
+
+
 def run_ranks(args):
     rows = []
     for ranks in args.ranks:
@@ -520,11 +615,18 @@ def main(argv):
     parser.add_argument("--scale-binary", default=os.path.join(build, "bin", "rgmcScale"))
     parser.add_argument("--threads", action="store_true",
                         help="the threads benchmark instead (rgmcThreadsBenchmark, one rank)")
-    parser.add_argument("--thread-counts", default="1,2", help="thread counts of --threads")
-    parser.add_argument("--threads-size", type=int, default=512, help="the phantom's points per axis")
+    parser.add_argument("--thread-counts", default="1,2", help="thread counts of --threads and --kernel")
+    parser.add_argument("--threads-size", type=int, default=512, help="the phantom's points per axis (--threads, --kernel)")
     parser.add_argument("--threads-repeats", type=int, default=3)
     parser.add_argument("--backend", default="STDThread", help="the vtkSMPTools backend of --threads")
     parser.add_argument("--threads-binary", default=os.path.join(build, "bin", "rgmcThreadsBenchmark"))
+    parser.add_argument("--kernel", action="store_true",
+                        help="the kernel benchmark instead (rgmcKernelBenchmark and the slider, one rank)")
+    parser.add_argument("--kernel-ct-size", type=int, default=384, help="the noisy head's points per axis")
+    parser.add_argument("--kernel-repeats", type=int, default=5)
+    parser.add_argument("--slider-changes", type=int, default=20,
+                        help="isovalue changes of the slider measurement (0: none)")
+    parser.add_argument("--kernel-binary", default=os.path.join(build, "bin", "rgmcKernelBenchmark"))
     parser.add_argument("--ranks-benchmark", action="store_true",
                         help="the ranks benchmark instead (rgmcRanks on --ranks, default 1,2,4)")
     parser.add_argument("--ranks-size", type=int, default=256, help="the scaffold's points per axis")
@@ -541,6 +643,11 @@ def main(argv):
             raise rgmc_common.UsageError("no threads program at %s: build first (./rgmc build)" % args.threads_binary)
         result = run_threads(args)
         return write_results(args.output, "threads", result, threads_report(result, args))
+    if args.kernel:
+        if not os.path.isfile(args.kernel_binary):
+            raise rgmc_common.UsageError("no kernel program at %s: build first (./rgmc build)" % args.kernel_binary)
+        result = run_kernel(args)
+        return write_results(args.output, "kernel", result, kernel_report(result, args))
     if args.ranks_benchmark:
         if not os.path.isfile(args.ranks_binary):
             raise rgmc_common.UsageError("no ranks program at %s: build first (./rgmc build)" % args.ranks_binary)
