@@ -151,15 +151,22 @@ void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& po
     const std::int64_t v = points[r];
     const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
     const double n = static_cast<double>(end - begin);
+    const double x[3] = { static_cast<double>(cur[3 * v]), static_cast<double>(cur[3 * v + 1]),
+      static_cast<double>(cur[3 * v + 2]) };
+    // Each coordinate's sum in the stencil's order (the same additions as one coordinate at a
+    // time), the neighbours read once.
+    double delta[3] = { 0.0, 0.0, 0.0 };
+    for (std::int64_t s = begin; s < end; ++s)
+    {
+      const T* w = cur + 3 * stencils.Neighbours[s];
+      for (int k = 0; k < 3; ++k)
+      {
+        delta[k] += static_cast<double>(w[k]) - x[k];
+      }
+    }
     for (int k = 0; k < 3; ++k)
     {
-      const double x = static_cast<double>(cur[3 * v + k]);
-      double delta = 0.0;
-      for (std::int64_t s = begin; s < end; ++s)
-      {
-        delta += static_cast<double>(cur[3 * stencils.Neighbours[s] + k]) - x;
-      }
-      next[3 * v + k] = static_cast<T>(end > begin ? x + relaxation * delta / n : x);
+      next[3 * v + k] = static_cast<T>(end > begin ? x[k] + relaxation * delta[k] / n : x[k]);
     }
   }
 }
