@@ -221,7 +221,7 @@ public:
 private:
   static constexpr int ChunkSlabs = 16;     // slabs of cubes per chunk (not per thread)
   static constexpr int ChunksPerReport = 8; // chunks between progress reports
-  static constexpr int PrefetchAhead = 8;   // nodes between a prefetch and the node's use
+  static constexpr int PrefetchAhead = 16;  // nodes between a prefetch and the node's use
 
   /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
   /// reset cheaply).
@@ -354,6 +354,14 @@ private:
         {
           const SurfaceNode& ahead = nodes[n + PrefetchAhead];
           this->Volume.PrefetchAround(ahead.I, ahead.J, ahead.K);
+          // And its vertices' slots: rows j and j + 1 of the slab's edge layers.
+          const std::int64_t at =
+            (ahead.I - box.Lo[0]) + this->LayerNx * std::int64_t(ahead.J - box.Lo[1]);
+          for (EdgeLayer* layer : { bottom[0], bottom[1], top[0], top[1], vertical })
+          {
+            __builtin_prefetch(&layer->Ids[at]);
+            __builtin_prefetch(&layer->Ids[at + this->LayerNx]);
+          }
         }
         const SurfaceNode& node = nodes[n];
         if (this->Volume.Evaluate(node.I, node.J, node.K, st))
