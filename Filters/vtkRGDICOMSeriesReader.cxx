@@ -568,8 +568,9 @@ struct SeriesScan
   double Direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 }; // row-major; columns: row direction,
                                                        // column direction, slice normal
   double Origin[3] = { 0, 0, 0 };
-  double SliceSpacing = 1.0; // the mean distance between slices along the normal
-  double Deviation = 0.0;    // the largest deviation of a slice gap from SliceSpacing
+  double SliceSpacing = 1.0; // the distance between slices along the normal (CheckSliceSpacing)
+  double Deviation = 0.0;    // files: the largest distance of a slice from its place in the
+                             // evenly spaced stack; frames: the largest deviation of a gap
   std::vector<Slice> Slices;
   int Dimensions[3] = { 0, 0, 0 };
   double Spacing[3] = { 1, 1, 1 };
@@ -1027,30 +1028,70 @@ bool SortAlongNormal(std::vector<FileHeader>& files, const double normal[3], std
   return true;
 }
 
-/// PASS 5 for several sorted files: the mean slice spacing and the largest deviation from it.
-/// Slices are never stacked as if evenly spaced when they are not (a missing slice, a variable
-/// spacing): under 1% of the mean gap, a warning with the spread; beyond, an error that names
-/// the gap.
+/// How far a slice may lie from its place in an evenly spaced stack and still be read as part of
+/// it: min(0.2 mm, a tenth of the spacing). 0.2 mm is the gap difference dcm2niix still treats
+/// as one spacing (scanners' rounded positions jitter by less); the tenth keeps a missing slice
+/// and a gap of 1.5 spacings errors on thin slices.
+double SliceTolerance(double spacing)
+{
+  return std::min(0.2, 0.1 * spacing);
+}
+
+/// PASS 5 for several sorted files: the slice spacing, fitted to the slices' positions along the
+/// normal (least squares: position = first + spacing * index), and how far a slice lies from its
+/// place in that evenly spaced stack. Scanners write positions as rounded decimal strings, so an
+/// oblique stack's gaps jitter: a slice within SliceTolerance of its place is rounding, and the
+/// stack is read on the fitted spacing (with a warning giving the spread when a gap differs from
+/// it by more than 1%). Farther, slices are never stacked as if evenly spaced: a missing slice or
+/// a variable spacing is an error that names the gap that differs most.
 bool CheckSliceSpacing(SeriesScan& scan, std::string& message)
 {
   const std::vector<FileHeader>& files = scan.Files;
+  const std::size_t n = files.size();
   const double extentAlong = files.back().Projection - files.front().Projection;
-  const double mean = extentAlong / (files.size() - 1);
-  double deviation = 0.0;
+  const double mean = extentAlong / (n - 1);
+  // The fit, about the middle index (sum of (s - middle)^2 = n (n^2 - 1) / 12).
+  const double middle = 0.5 * static_cast<double>(n - 1);
+  double meanPosition = 0.0;
+  for (const FileHeader& h : files)
+  {
+    meanPosition += h.Projection;
+  }
+  meanPosition /= static_cast<double>(n);
+  double moment = 0.0;
+  for (std::size_t s = 0; s < n; ++s)
+  {
+    moment += (static_cast<double>(s) - middle) * (files[s].Projection - meanPosition);
+  }
+  const double spacing =
+    moment / (static_cast<double>(n) * (static_cast<double>(n) * n - 1.0) / 12.0);
+  double offPlace = 0.0; // the largest distance of a slice from its fitted place
+  std::size_t farthest = 0;
+  for (std::size_t s = 0; s < n; ++s)
+  {
+    const double place = meanPosition + (static_cast<double>(s) - middle) * spacing;
+    if (std::fabs(files[s].Projection - place) > offPlace)
+    {
+      offPlace = std::fabs(files[s].Projection - place);
+      farthest = s;
+    }
+  }
+  double gapDeviation = 0.0;
   std::size_t worst = 1;
   double smallest = extentAlong, largest = 0.0;
-  for (std::size_t s = 1; s < files.size(); ++s)
+  for (std::size_t s = 1; s < n; ++s)
   {
     const double gap = files[s].Projection - files[s - 1].Projection;
     smallest = std::min(smallest, gap);
     largest = std::max(largest, gap);
-    if (std::fabs(gap - mean) > deviation)
+    if (std::fabs(gap - spacing) > gapDeviation)
     {
-      deviation = std::fabs(gap - mean);
+      gapDeviation = std::fabs(gap - spacing);
       worst = s;
     }
   }
-  if (deviation >= 0.01 * mean)
+  const double tolerance = SliceTolerance(spacing);
+  if (offPlace > tolerance)
   {
     message = "the slices of " + scan.Directory +
       " are not evenly spaced: " + files[worst - 1].Path + " and " + files[worst].Path + " are " +
@@ -1058,21 +1099,26 @@ bool CheckSliceSpacing(SeriesScan& scan, std::string& message)
       " mm apart along the slice normal (at " + Describe(files[worst - 1].Projection) + " and " +
       Describe(files[worst].Projection) + " mm), the mean gap is " + Describe(mean) +
       " mm (a missing slice, or a variable spacing); gaps range from " + Describe(smallest) +
-      " to " + Describe(largest) + " mm" +
+      " to " + Describe(largest) + " mm; " + BaseName(files[farthest].Path) + " lies " +
+      Describe(offPlace) + " mm from its place in the evenly spaced stack that fits best (" +
+      Describe(spacing) + " mm apart), more than the " + Describe(tolerance) +
+      " mm allowed for rounded positions" +
       (scan.LeftOut.empty() ? std::string()
                             : "; left out of this stack as another acquisition: " + scan.LeftOut);
     return false;
   }
-  if (deviation > std::max(1e-3 * mean, 1e-4))
+  if (gapDeviation > 0.01 * spacing)
   {
     scan.Warnings << "irregular slice spacing in " << scan.Directory << ": the gaps between "
                   << "slices range from " << Describe(smallest) << " to " << Describe(largest)
-                  << " mm (mean " << Describe(mean) << " mm; largest deviation "
-                  << Describe(deviation) << " mm, at " << BaseName(files[worst].Path)
-                  << ", under 1%); the volume is read with the mean spacing\n";
+                  << " mm (the fitted spacing is " << Describe(spacing)
+                  << " mm; every slice lies within " << Describe(offPlace)
+                  << " mm of its place, at most " << Describe(tolerance)
+                  << " mm is taken as rounded positions); the volume is read with the fitted "
+                     "spacing\n";
   }
-  scan.SliceSpacing = mean;
-  scan.Deviation = deviation;
+  scan.SliceSpacing = spacing;
+  scan.Deviation = offPlace;
   return true;
 }
 
@@ -1100,7 +1146,9 @@ void WarnOfGantryTilt(SeriesScan& scan)
     offPlane = std::max(offPlane, vtkMath::Norm(d));
     lastOff = vtkMath::Norm(d);
   }
-  if (offPlane > std::max(1e-3 * scan.SliceSpacing, 1e-3))
+  // Shifts no larger than the rounding that CheckSliceSpacing accepts along the normal are
+  // rounded positions (an oblique stack's, written as decimal strings), not a tilt.
+  if (offPlane > SliceTolerance(scan.SliceSpacing))
   {
     const double tilt = vtkMath::DegreesFromRadians(std::atan2(lastOff, extentAlong));
     scan.Warnings << "the slices of " << scan.Directory << " are shifted within their planes by "

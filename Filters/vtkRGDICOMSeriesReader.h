@@ -69,8 +69,10 @@ public:
   /**
    * After an update: the series found in the directory, one per line ("UID: N files,
    * description"), the chosen one first; the number of files of the series; the file of slice
-   * k (sorted; null when out of range); the rescale of the first slice; the largest deviation
-   * of a slice gap from the mean slice spacing (mm).
+   * k (sorted; null when out of range); the rescale of the first slice; how far the slices are
+   * from an evenly spaced stack (mm): for a series of files, the largest distance of a slice
+   * from its place in the evenly spaced stack fitted to their positions; for a multi-frame
+   * file, the largest deviation of a frame gap from the mean.
    */
   const char* GetSeriesList() const { return this->SeriesList.c_str(); }
   int GetNumberOfFiles() const;

@@ -34,7 +34,12 @@ DEFECTS = {
     "pixel-spacing": "one file's PixelSpacing differs",
     "duplicate-position": "two files at the same ImagePositionPatient",
     "irregular-spacing": "one slice moved by 0.3 slice spacings (an error: not evenly spaced)",
-    "slightly-irregular-spacing": "one slice moved by 0.005 slice spacings (under 1%: a warning)",
+    "slightly-irregular-spacing": "one slice moved by 0.005 slice spacings (read: within rounding)",
+    "rounded-positions": "ImagePositionPatient written with one decimal, as some scanners do (an "
+                         "oblique stack's gaps then jitter: read, with a warning above 1%)",
+    "missing-slice": "the middle slice left out (an error: a gap of 2 spacings)",
+    "wide-gap": "the slices from the middle on moved by half a spacing (an error: a gap of 1.5)",
+    "drift": "gaps growing steadily from 0.95 to 1.05 spacings (an error: a variable spacing)",
     "image-size": "one file has one column fewer",
     "no-position": "one file lacks ImagePositionPatient",
     "second-series": "a second series of 3 files in the same directory (a warning)",
@@ -186,6 +191,12 @@ def write_series(args, volume, origin, spacing):
             position = position + k * spacing[2] * math.tan(math.radians(12.0)) * col
         if args.defect == "slightly-irregular-spacing" and k == defect_slice:
             position = position + 0.005 * spacing[2] * normal
+        if args.defect == "wide-gap" and k >= defect_slice:
+            position = position + 0.5 * spacing[2] * normal
+        if args.defect == "drift":
+            position = position + 0.05 * spacing[2] * (k * k / (nz - 1.0) - k) * normal
+        if args.defect == "missing-slice" and k == defect_slice:
+            continue
         if args.defect == "duplicate-position" and k == defect_slice:
             position = np.asarray(origin) + (k - 1) * spacing[2] * normal
         if args.defect == "image-size" and k == defect_slice:
@@ -197,6 +208,8 @@ def write_series(args, volume, origin, spacing):
                                           list(tilted[:, 0]) + list(tilted[:, 1])]
         if args.defect == "pixel-spacing" and k == defect_slice:
             ds.PixelSpacing = [number(spacing[1] * 1.5), number(spacing[0])]
+        if args.defect == "rounded-positions":
+            ds.ImagePositionPatient = ["%.1f" % v for v in position]
         if args.defect == "no-position" and k == defect_slice:
             del ds.ImagePositionPatient
         if args.defect == "transfer-syntax" and k == defect_slice:
@@ -227,7 +240,7 @@ def write_series(args, volume, origin, spacing):
             ds.SeriesDescription = "RGMC scout"
             ds.save_as(os.path.join(args.output, "SCOUT%d" % k), write_like_original=False)
     print("written: %s (%d files, %d x %d x %d, spacing %s mm, slope %g, intercept %g, %s%s%s)"
-          % (args.output, nz, nx, ny, nz, ",".join(number(s) for s in spacing), args.slope,
+          % (args.output, len(written), nx, ny, nz, ",".join(number(s) for s in spacing), args.slope,
              args.intercept, args.transfer_syntax,
              ", oblique %g degrees" % args.oblique if args.oblique else "",
              ", defect " + args.defect if args.defect else ""))

@@ -284,7 +284,12 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
     { "no-position", { "/no-position/IM", "has no ImagePositionPatient" } },
     { "transfer-syntax", { "/transfer-syntax/IM", "unsupported transfer syntax", "MPEG" } },
     { "irregular-spacing",
-      { "are not evenly spaced", "/irregular-spacing/IM", "mm apart along", "the mean gap is" } },
+      { "are not evenly spaced", "/irregular-spacing/IM", "mm apart along", "the mean gap is",
+        "from its place in the evenly spaced stack that fits best" } },
+    // Not rounding: a missing slice, a gap of 1.5 spacings, a steady drift of the gaps.
+    { "missing-slice", { "are not evenly spaced", "/missing-slice/IM", "a missing slice" } },
+    { "wide-gap", { "are not evenly spaced", "/wide-gap/IM", "mm allowed for rounded positions" } },
+    { "drift", { "are not evenly spaced", "/drift/IM", "variable spacing" } },
   };
   if (rank == 0)
   {
@@ -293,6 +298,8 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
       Generate(dir, npy, whole, d.Name, "--slope 1 --intercept -1024 --defect " + d.Name);
     }
     Generate(dir, npy, whole, "slightly-irregular-spacing", "--defect slightly-irregular-spacing");
+    Generate(
+      dir, npy, whole, "rounded-positions", "--oblique 30 --axis 1,2,3 --defect rounded-positions");
     Generate(dir, npy, whole, "second-series", "--defect second-series");
     Generate(dir, npy, whole, "localizer", "--defect localizer");
     Generate(dir, npy, whole, "gantry-tilt", "--defect gantry-tilt");
@@ -311,22 +318,49 @@ void BadSeries(vtkMultiProcessController* controller, const std::string& dir,
   ExpectError(controller, read(dir + "/not-dicom"), "no DICOM file", { "no DICOM image" });
   ExpectError(controller, read(dir + "/missing"), "missing directory", { "no such file" });
 
-  // Spacing irregular by less than 1%: a warning with the spread, the volume still read.
+  // One slice 0.005 spacings off its place: rounding, read on the fitted spacing without a
+  // word; the largest distance from the fitted stack is the moved slice's, from the least
+  // squares line over n slices (its residual: shift * (1 - 1/n - (k - m)^2 / S), m the middle
+  // index, S = n (n^2 - 1) / 12).
   {
     vtkSmartPointer<vtkRGDICOMSeriesReader> reader =
       Reader(controller, dir + "/slightly-irregular-spacing");
     PieceRead r = ReadPiece(reader, rank, ranks, 0);
-    const double expected = 0.005 * whole->GetSpacing()[2];
-    RGMC_CHECK(r.Ok && r.Errors.empty(), "irregular spacing: " << r.Errors);
-    RGMC_CHECK(r.Warnings.find("irregular slice spacing") != std::string::npos,
-      "irregular spacing: no warning on rank " << rank << " [" << r.Warnings << "]");
+    const double n = Dims[2], k = Dims[2] / 2, m = 0.5 * (n - 1), S = n * (n * n - 1) / 12;
+    const double expected = 0.005 * whole->GetSpacing()[2] * (1 - 1 / n - (k - m) * (k - m) / S);
+    RGMC_CHECK(r.Ok && r.Errors.empty(), "slightly irregular spacing: " << r.Errors);
+    RGMC_CHECK(r.Warnings.find("irregular slice spacing") == std::string::npos,
+      "slightly irregular spacing: a warning on rank " << rank << " [" << r.Warnings << "]");
     RGMC_CHECK(std::fabs(reader->GetLargestSpacingDeviation() - expected) < 1e-9,
-      "irregular spacing: largest deviation " << reader->GetLargestSpacingDeviation()
-                                              << ", expected " << expected);
-    RGMC_CHECK(r.Image->GetNumberOfPoints() > 0, "irregular spacing: nothing read");
+      "slightly irregular spacing: largest deviation " << reader->GetLargestSpacingDeviation()
+                                                       << ", expected " << expected);
+    RGMC_CHECK(r.Image->GetNumberOfPoints() > 0, "slightly irregular spacing: nothing read");
+  }
+  // An oblique stack whose positions are written with one decimal, as some scanners do: its
+  // gaps jitter by several percent, every slice within 0.1 mm of its place. Read, with a
+  // warning giving the spread, on a fitted spacing that puts the far end of the stack within
+  // 0.2 mm of where the unrounded positions put it.
+  {
+    vtkSmartPointer<vtkRGDICOMSeriesReader> reader = Reader(controller, dir + "/rounded-positions");
+    PieceRead r = ReadPiece(reader, rank, ranks, 0);
+    const double spacing = whole->GetSpacing()[2];
+    RGMC_CHECK(r.Ok && r.Errors.empty(), "rounded positions: " << r.Errors);
+    RGMC_CHECK(r.Warnings.find("irregular slice spacing") != std::string::npos &&
+        r.Warnings.find("the volume is read with the fitted spacing") != std::string::npos,
+      "rounded positions: no warning on rank " << rank << " [" << r.Warnings << "]");
+    RGMC_CHECK(
+      reader->GetLargestSpacingDeviation() > 0.01 && reader->GetLargestSpacingDeviation() < 0.1,
+      "rounded positions: slices up to " << reader->GetLargestSpacingDeviation()
+                                         << " mm from their places (rounding to 0.1 mm)");
+    if (r.Ok)
+    {
+      const double read = r.Image->GetSpacing()[2];
+      RGMC_CHECK(std::fabs(read - spacing) * (Dims[2] - 1) < 0.2,
+        "rounded positions: spacing " << read << " mm, the positions' " << spacing << " mm");
+    }
     if (rank == 0)
     {
-      std::cout << "irregular spacing: " << ReaderMessage(r.Warnings) << "\n";
+      std::cout << "rounded positions: " << ReaderMessage(r.Warnings) << "\n";
     }
   }
   // A tilted gantry (slices sheared along their planes): said, with the angle; still read.

@@ -50,7 +50,17 @@ GENERATED = [
     ("sagittal", "--slope 1 --intercept -1024 --oblique 90 --axis 0,1,0"),
     ("bigendian", "--slope 0.25 --intercept -2048.5 --transfer-syntax explicit-big"),
     ("coronal-rle", "--slope 1 --intercept -1024 --oblique 90 --axis 1,0,0 --transfer-syntax rle"),
+    ("rounded-positions", "--slope 1 --intercept -1024 --oblique 30 --axis 1,2,3 "
+                          "--defect rounded-positions"),
 ]
+# An oblique stack whose positions are written with one decimal, as some scanners do: each
+# coordinate is off by up to 0.05 mm, so the slices jitter about an evenly spaced stack. The
+# reader fits the spacing to every slice (least squares) along the normal of the orientation;
+# dcm2niix takes its slice axis from the first and last slices' rounded positions (whose
+# difference is off by up to 2 x 0.05 x sqrt(3) = 0.17 mm, direction included). The two agree
+# within that and the fit's own error (at most 0.1 mm here), not to 1e-4 mm; the reader's
+# spacing against the unrounded positions is checked in TestDICOMSeries.
+CORNER_TOLERANCE_MM = {"rounded-positions": 0.3}
 REAL = ["rtdose.dcm", "rtdose_expb.dcm", "rtdose_rle.dcm"]
 TWINS = {"rtdose_rle": "rtdose"}  # pydicom decodes both to the same samples
 NO_SLICE_SPACING = "Unable to determine slice thickness"
@@ -269,8 +279,9 @@ def compare(name, ranks, pieces, oracle, frame_spacing, twin):
         for m in corners(geometry["extent"]):
             expected = lps[:3, :3] @ m + lps[:3, 3]
             worst = max(worst, float(np.abs(position(geometry, m) - expected).max()))
-    check(worst <= TOLERANCE_MM, "%s: corners %.3g mm from dcm2niix's (tolerance %g mm)"
-          % (what, worst, TOLERANCE_MM))
+    tolerance = CORNER_TOLERANCE_MM.get(name, TOLERANCE_MM)
+    check(worst <= tolerance, "%s: corners %.3g mm from dcm2niix's (tolerance %g mm)"
+          % (what, worst, tolerance))
     spacing = np.linalg.norm(lps[:3, :3], axis=0)
     direction = lps[:3, :3] / spacing
     g = pieces[0][0]
