@@ -46,6 +46,8 @@
 namespace
 {
 
+using rgmc_benchmark::FastestUpdate;
+using rgmc_benchmark::IntList;
 using rgmc_benchmark::Now;
 
 /// A volume to extract from, with its isovalue and a seed on the structure (world).
@@ -134,20 +136,6 @@ Volume NoisyHead(int size)
   return v;
 }
 
-/// The smallest of `repeats` wall times of `run`.
-template <typename Run>
-double Fastest(int repeats, Run&& run)
-{
-  double best = 1e300;
-  for (int r = 0; r < repeats; ++r)
-  {
-    const double start = Now();
-    run();
-    best = std::min(best, Now() - start);
-  }
-  return best;
-}
-
 const rgmc::CaseTable& Table()
 {
   static const rgmc::CaseTable table(&vtkMarchingCubesTriangleCases::GetCases()[0].edges[0]);
@@ -234,12 +222,7 @@ double FilterSeconds(const Volume& v, int mode, int repeats, long long& triangle
   {
     rg->AddSeedPoint(v.Seed[0], v.Seed[1], v.Seed[2]);
   }
-  const double seconds = Fastest(repeats,
-    [&]()
-    {
-      rg->Modified();
-      rg->Update();
-    });
+  const double seconds = FastestUpdate(repeats, rg.Get());
   triangles = rg->GetOutput()->GetNumberOfCells();
   return seconds;
 }
@@ -251,12 +234,7 @@ double FlyingEdgesSeconds(const Volume& v, int repeats, long long& triangles)
   flying->SetValue(0, v.Isovalue);
   flying->ComputeNormalsOn();
   flying->ComputeScalarsOff();
-  const double seconds = Fastest(repeats,
-    [&]()
-    {
-      flying->Modified();
-      flying->Update();
-    });
+  const double seconds = FastestUpdate(repeats, flying.Get());
   triangles = flying->GetOutput()->GetNumberOfCells();
   return seconds;
 }
@@ -295,12 +273,7 @@ int main(int argc, char* argv[])
     }
     else if (arg == "--threads")
     {
-      threadCounts.clear();
-      std::stringstream list(argv[a + 1]);
-      for (std::string item; std::getline(list, item, ',');)
-      {
-        threadCounts.push_back(std::atoi(item.c_str()));
-      }
+      threadCounts = IntList(argv[a + 1]);
     }
     else
     {

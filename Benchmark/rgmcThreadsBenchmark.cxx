@@ -29,21 +29,8 @@
 namespace
 {
 
-using rgmc_benchmark::Now;
-
-/// The smallest of `repeats` wall times of `run`.
-template <typename Run>
-double Fastest(int repeats, Run&& run)
-{
-  double best = 1e300;
-  for (int r = 0; r < repeats; ++r)
-  {
-    const double start = Now();
-    run();
-    best = std::min(best, Now() - start);
-  }
-  return best;
-}
+using rgmc_benchmark::FastestUpdate;
+using rgmc_benchmark::IntList;
 
 } // namespace
 
@@ -69,12 +56,7 @@ int main(int argc, char* argv[])
     }
     else if (arg == "--threads")
     {
-      threadCounts.clear();
-      std::stringstream list(argv[a + 1]);
-      for (std::string item; std::getline(list, item, ',');)
-      {
-        threadCounts.push_back(std::atoi(item.c_str()));
-      }
+      threadCounts = IntList(argv[a + 1]);
     }
     else
     {
@@ -114,24 +96,14 @@ int main(int argc, char* argv[])
         flying->SetValue(0, 400);
         flying->ComputeNormalsOn();
         flying->ComputeScalarsOff();
-        fe = Fastest(repeats,
-          [&]()
-          {
-            flying->Modified();
-            flying->Update();
-          });
+        fe = FastestUpdate(repeats, flying.Get());
         feTriangles = flying->GetOutput()->GetNumberOfCells();
 
         vtkNew<vtkRGMarchingCubes> rg;
         rg->SetInputData(image);
         rg->SetIsovalue(400);
         rg->AddSeedPoint(0, 0, 105);
-        seeded = Fastest(repeats,
-          [&]()
-          {
-            rg->Modified();
-            rg->Update();
-          });
+        seeded = FastestUpdate(repeats, rg.Get());
         seededTriangles = rg->GetOutput()->GetNumberOfCells();
         auto seededOut = vtkSmartPointer<vtkPolyData>::New();
         seededOut->DeepCopy(rg->GetOutput());
@@ -141,22 +113,12 @@ int main(int argc, char* argv[])
         repairFilter->SetSmoothingMethod(vtkRGSeamRepair::LAPLACIAN);
         repairFilter->SetNumberOfIterations(20);
         repairFilter->SetRelaxationFactor(0.01);
-        repair = Fastest(repeats,
-          [&]()
-          {
-            repairFilter->Modified();
-            repairFilter->Update();
-          });
+        repair = FastestUpdate(repeats, repairFilter.Get());
         auto repaired = vtkSmartPointer<vtkPolyData>::New();
         repaired->DeepCopy(repairFilter->GetOutput());
 
         rg->SetExtractionMode(vtkRGMarchingCubes::ALL_COMPONENTS);
-        all = Fastest(repeats,
-          [&]()
-          {
-            rg->Modified();
-            rg->Update();
-          });
+        all = FastestUpdate(repeats, rg.Get());
         allTriangles = rg->GetOutput()->GetNumberOfCells();
         auto allOut = vtkSmartPointer<vtkPolyData>::New();
         allOut->DeepCopy(rg->GetOutput());

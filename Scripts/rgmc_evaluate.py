@@ -98,6 +98,21 @@ def machine():
     return "%s, %d cores%s, %s" % (cpu, os.cpu_count(), memory, platform.platform())
 
 
+def report_header(title):
+    """A benchmark report's first lines: its title, the machine and date, the command."""
+    return [title, "", "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
+            "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), ""]
+
+
+def run_json(command, name):
+    """Runs a benchmark program (printing the command); its standard output, as JSON."""
+    print("+ " + " ".join(command), flush=True)
+    process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
+    if process.returncode != 0:
+        raise rgmc_common.UsageError("%s failed (exit %d)" % (name, process.returncode))
+    return json.loads(process.stdout)
+
+
 def run(args):
     processes = max(args.ranks)
     command = rgmc_common.mpiexec_command(processes) + [
@@ -350,9 +365,7 @@ def scale_report(rows, args):
     counts = sorted({r["ranks"] for r in rows})
     at = {(r["stage"], r["ranks"]): r for r in rows}
     triangles = max(r["triangles"] for r in rows)
-    lines = ["# RGMC scale benchmark", "",
-             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
-             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+    lines = report_header("# RGMC scale benchmark") + [
              "A %d^3 float gyroid (period %g voxels): %d triangles, one surface through every "
              "partition plane. Extraction (all components, with normals) -> Seam Repair -> 5 Laplacian "
              "iterations -> merged STL, then PLY, written by every rank into one file. Seconds are the "
@@ -392,19 +405,13 @@ def scale_report(rows, args):
 def run_threads(args):
     command = [args.threads_binary, "--size", str(args.threads_size), "--threads",
                args.thread_counts, "--repeats", str(args.threads_repeats), "--backend", args.backend]
-    print("+ " + " ".join(command), flush=True)
-    process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
-    if process.returncode != 0:
-        raise rgmc_common.UsageError("rgmcThreadsBenchmark failed (exit %d)" % process.returncode)
-    return json.loads(process.stdout)
+    return run_json(command, "rgmcThreadsBenchmark")
 
 
 def threads_report(result, args):
     runs = result["runs"]
     one = runs[0]
-    lines = ["# RGMC threads benchmark", "",
-             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
-             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+    lines = report_header("# RGMC threads benchmark") + [
              "The CT phantom at %d^3 on one rank, isovalue 400; seeded on the skull (0, 0, 105). "
              "Minimum of %d runs. Seam Repair + 20 Laplacian iterations (relaxation 0.01) on the "
              "seeded surface." % (result["size"], result["repeats"]), "",
@@ -447,11 +454,7 @@ def run_kernel(args):
     command = [args.kernel_binary, "--size", str(args.threads_size), "--ct-size",
                str(args.kernel_ct_size), "--threads", args.thread_counts, "--repeats",
                str(args.kernel_repeats)]
-    print("+ " + " ".join(command), flush=True)
-    process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
-    if process.returncode != 0:
-        raise rgmc_common.UsageError("rgmcKernelBenchmark failed (exit %d)" % process.returncode)
-    result = json.loads(process.stdout)
+    result = run_json(command, "rgmcKernelBenchmark")
     result["slider"] = []
     plugin = rgmc_common.find_plugin()
     if args.slider_changes > 0 and plugin:
@@ -473,9 +476,7 @@ def run_kernel(args):
 
 def kernel_report(result, args):
     runs = result["runs"]
-    lines = ["# RGMC kernel benchmark", "",
-             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
-             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+    lines = report_header("# RGMC kernel benchmark") + [
              "One rank, vtkSMPTools' STDThread backend. Minimum of %d runs. Seeded: from one seed "
              "on the skull; the stages are the kernel's (rgmc::SurfaceKernel on the image's "
              "samples), 'rest' is the filter's time minus the stages (input checks, the decision, "
@@ -547,9 +548,7 @@ def run_ranks(args):
 
 def ranks_report(rows, args):
     cores = os.cpu_count() or 1
-    lines = ["# RGMC ranks benchmark", "",
-             "Machine: %s. Date: %s." % (machine(), datetime.date.today().isoformat()), "",
-             "Command: `%s`" % " ".join(["python3", "Scripts/rgmc_evaluate.py"] + sys.argv[1:]), "",
+    lines = report_header("# RGMC ranks benchmark") + [
              "A run's time is its slowest rank's, the minimum of %d runs; each rank computes its own "
              "block of the volume. Rounds: of seeded growth between ranks; collectives: per rank; "
              "messages: the most a rank sent (sizes and data). Ranks above %d cores are "

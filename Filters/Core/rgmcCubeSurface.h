@@ -631,25 +631,6 @@ public:
     }
   }
 
-private:
-  RGMC_INLINE void PrefetchSamples(int i, int j, int k) const
-  {
-    if (i <= this->CentralLo[0] || i >= this->CentralHi[0] || j <= this->CentralLo[1] ||
-      j >= this->CentralHi[1] || k <= this->CentralLo[2] || k >= this->CentralHi[2])
-    {
-      return;
-    }
-    const auto* at = &this->Samples[this->GridOf.LocalIndex(i, j, k)];
-    const std::int64_t sy = this->GridOf.StrideY, sz = this->GridOf.StrideZ;
-    for (const std::int64_t row : { -sz, -sz + sy, -sy, std::int64_t(0), sy, 2 * sy, sz - sy, sz,
-           sz + sy, sz + 2 * sy, 2 * sz, 2 * sz + sy })
-    {
-      __builtin_prefetch(at + row - 1);
-      __builtin_prefetch(at + row + 2);
-    }
-  }
-
-public:
   /// The surface nodes of cube (i, j, k) with samples `st`.
   RGMC_INLINE void Describe(int i, int j, int k, const CubeSamples& st, CubeSurface& surface) const
   {
@@ -744,6 +725,23 @@ public:
   }
 
 private:
+  RGMC_INLINE void PrefetchSamples(int i, int j, int k) const
+  {
+    if (i <= this->CentralLo[0] || i >= this->CentralHi[0] || j <= this->CentralLo[1] ||
+      j >= this->CentralHi[1] || k <= this->CentralLo[2] || k >= this->CentralHi[2])
+    {
+      return;
+    }
+    const auto* at = &this->Samples[this->GridOf.LocalIndex(i, j, k)];
+    const std::int64_t sy = this->GridOf.StrideY, sz = this->GridOf.StrideZ;
+    for (const std::int64_t row : { -sz, -sz + sy, -sy, std::int64_t(0), sy, 2 * sy, sz - sy, sz,
+           sz + sy, sz + 2 * sy, 2 * sz, 2 * sz + sy })
+    {
+      __builtin_prefetch(at + row - 1);
+      __builtin_prefetch(at + row + 2);
+    }
+  }
+
   void Fail(int i, int j, int k)
   {
     std::lock_guard<std::mutex> lock(this->ErrorMutex);

@@ -13,6 +13,7 @@
 
 #include "vtkMarchingCubesTriangleCases.h"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <iostream>
@@ -70,16 +71,33 @@ std::vector<T> Field(const int n[3], bool withNaN)
   return values;
 }
 
+/// A volume of n points per axis cut into `boxes` of cubes, seen by `owner`, at the isovalue 3.
+struct Piece
+{
+  Piece(const int n[3], std::vector<rgmc::CellBox> boxes = {}, int owner = 0)
+    : GridOf(Whole(n).data(), Whole(n).data())
+    , Owned(boxes.empty() ? std::vector<rgmc::CellBox>{ this->GridOf.WholeCells() } : boxes, owner)
+  {
+    this->Options.Isovalue = 3.0;
+  }
+  static std::array<int, 6> Whole(const int n[3])
+  {
+    return { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
+  }
+  rgmc::Grid GridOf;
+  rgmc::Ownership Owned;
+  rgmc::SurfaceOptions Options;
+};
+
 template <typename T>
 void CheckClassifyRow(const char* what, bool withNaN)
 {
   const int n[3] = { 70, 9, 7 };
   const std::vector<T> values = Field<T>(n, withNaN);
-  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
-  const rgmc::Grid grid(whole, whole);
-  const rgmc::Ownership own({ grid.WholeCells() }, 0);
-  rgmc::SurfaceOptions options;
-  options.Isovalue = 3.0;
+  const Piece piece(n);
+  const rgmc::Grid& grid = piece.GridOf;
+  const rgmc::Ownership& own = piece.Owned;
+  const rgmc::SurfaceOptions& options = piece.Options;
   rgmc::SampledVolume<std::vector<T>> volume(Table(), grid, own, values, options);
   int rows = 0;
   for (int k = 0; k < n[2]; ++k)
@@ -190,12 +208,9 @@ void CheckEdgeNeighbours()
 void CheckScan(const char* what, const int n[3], const std::vector<rgmc::CellBox>& boxes, int owner)
 {
   const std::vector<float> values = Field<float>(n, false);
-  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
-  const rgmc::Grid grid(whole, whole);
-  const rgmc::Ownership own(boxes, owner);
-  rgmc::SurfaceOptions options;
-  options.Isovalue = 3.0;
-  rgmc::SampledVolume<std::vector<float>> volume(Table(), grid, own, values, options);
+  const Piece piece(n, boxes, owner);
+  const rgmc::Ownership& own = piece.Owned;
+  rgmc::SampledVolume<std::vector<float>> volume(Table(), piece.GridOf, own, values, piece.Options);
   rgmc::ComponentSet components;
   rgmc::SurfaceGrowth<std::vector<float>> growth(volume, components);
   growth.GrowAll();
@@ -245,12 +260,9 @@ void CheckNaNAwayFromSurface()
     // A small surface far from the NaN, so that the scan has work elsewhere.
     values[3 + n[0] * (3 + n[1] * 3)] = level < 0 ? 10.0f : -5.0f;
     values[40 + n[0] * (33 + n[1] * 30)] = std::numeric_limits<float>::quiet_NaN();
-    const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
-    const rgmc::Grid grid(whole, whole);
-    const rgmc::Ownership own({ grid.WholeCells() }, 0);
-    rgmc::SurfaceOptions options;
-    options.Isovalue = 3.0;
-    rgmc::SurfaceKernel<std::vector<float>> kernel(Table(), grid, own, values, options);
+    const Piece piece(n);
+    rgmc::SurfaceKernel<std::vector<float>> kernel(
+      Table(), piece.GridOf, piece.Owned, values, piece.Options);
     kernel.GrowAll();
     const std::string error = kernel.Error();
     RGMC_CHECK(error.find("(40, 33, 30) is NaN") != std::string::npos,
@@ -268,8 +280,7 @@ int main()
   CheckEdgeNeighbours();
   // Partial tiles (70 = 2 x 32 + 6 points), more than one tile along each axis.
   const int n[3] = { 70, 45, 38 };
-  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
-  const rgmc::CellBox all = rgmc::Grid(whole, whole).WholeCells();
+  const rgmc::CellBox all = Piece(n).GridOf.WholeCells();
   CheckScan("one owner", n, { all }, 0);
   // A piece whose box overlaps a lower rank's (the holes of a reader that ignores pieces):
   // rank 1 owns its box minus rank 0's.
