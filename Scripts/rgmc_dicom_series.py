@@ -1,6 +1,8 @@
-"""Writes a CT volume as a DICOM series with known geometry: RGMC's phantom, or any int volume.
+"""Writes a CT volume as a DICOM series with known geometry: RGMC's phantom, a real CT from an
+InVesalius project, or any int volume.
 
   pvbatch Scripts/rgmc_dicom_series.py --phantom 256 --output ct-phantom-dicom/
+  /usr/bin/python3 Scripts/rgmc_dicom_series.py --inv3 Cranium.inv3 --output cranium-dicom/
   /usr/bin/python3 Scripts/rgmc_dicom_series.py --volume hu.npy --spacing 1,1,1 \\
       --origin=-128,-128,-128 --output series/
 
@@ -13,7 +15,8 @@ with --oblique, an ImageOrientationPatient rotated about the axis --axis through
 Voxel (i, j, k) of the volume (numpy order [k, j, i]) lies at origin + R (i sx, j sy, k sz) in
 LPS patient coordinates, R the rotation; the phantom's origin and spacing are its own, so the
 series lands where the phantom's .vti does. --phantom needs ParaView (run with pvbatch);
---volume needs only Debian's python3 with python3-numpy and python3-pydicom.
+--volume and --inv3 (an InVesalius 3 project's volume, its spacing, origin 0: Scripts/rgmc_inv3.py)
+need only Debian's python3 with python3-numpy and python3-pydicom.
 
 --defect writes a broken series on purpose, for the reader's error tests (see --help).
 """
@@ -143,12 +146,12 @@ def write_series(args, volume, origin, spacing):
         ds.SOPClassUID = meta.MediaStorageSOPClassUID
         ds.SOPInstanceUID = meta.MediaStorageSOPInstanceUID
         ds.Modality = "CT"
-        ds.PatientName = "RGMC^Phantom"
-        ds.PatientID = "RGMC-PHANTOM"
+        ds.PatientName = args.patient_name
+        ds.PatientID = args.patient_id
         ds.StudyInstanceUID = study
         ds.SeriesInstanceUID = series_uid
         ds.FrameOfReferenceUID = frame
-        ds.SeriesDescription = "RGMC CT phantom"
+        ds.SeriesDescription = args.description
         ds.SeriesNumber = 1
         ds.InstanceNumber = nz - k if k < nz else k + 1
         ds.ImagePositionPatient = [number(v) for v in position]
@@ -256,6 +259,8 @@ def main(argv):
     source.add_argument("--phantom", type=int, metavar="N",
                         help="the CT phantom at N^3 (needs pvbatch and the plugin)")
     source.add_argument("--volume", help="a .npy array [k, j, i] of integers")
+    source.add_argument("--inv3", metavar="PROJECT",
+                        help="the volume of an InVesalius 3 project (.inv3), with its spacing")
     parser.add_argument("--output", required=True, help="the directory to write")
     parser.add_argument("--spacing", type=lambda t: parse_triple(t, "--spacing"),
                         help="x,y,z voxel spacing in mm (--volume; default 1,1,1)")
@@ -277,6 +282,23 @@ def main(argv):
     args = parser.parse_args(argv)
     if args.slope == 0:
         parser.error("--slope must not be 0")
+    args.patient_name, args.patient_id = "RGMC^Phantom", "RGMC-PHANTOM"
+    args.description = "RGMC CT phantom"
+    if args.inv3:
+        import rgmc_inv3
+        try:
+            project = rgmc_inv3.Project(args.inv3)
+            volume = project.volume()
+        except rgmc_inv3.ProjectError as error:
+            parser.error(str(error))
+        if volume.dtype.kind not in "iu":
+            parser.error("%s holds %s samples, not integers" % (args.inv3, volume.dtype))
+        origin = args.origin or [0.0, 0.0, 0.0]
+        spacing = args.spacing or project.spacing
+        args.patient_name = args.patient_id = project.name or "InVesalius project"
+        args.description = "%s %s (InVesalius project %s)" % (
+            project.name, project.modality, os.path.basename(args.inv3))
+        return write_series(args, volume, origin, spacing)
     if args.phantom is not None:
         if args.phantom < 2:
             parser.error("--phantom must be at least 2")

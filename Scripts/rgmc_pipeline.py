@@ -74,6 +74,10 @@ def parse_args(argv):
     parser.add_argument("--formats", default="stl,vtp",
                         help="comma-separated formats to write: stl, ply, vtp (default stl,vtp)")
     parser.add_argument("--screenshot", help="also render the surface to this PNG")
+    parser.add_argument("--beside-contour", action="store_true",
+                        help="with --screenshot: the picture shows ParaView's Contour of the "
+                        "whole volume at the same isovalue on the left, the extracted surface "
+                        "with its seeds marked on the right")
     parser.add_argument("--color-by", choices=["solid", "rank", "component"], default="solid",
                         help="colour of the picture: solid, by rank (the decomposition), or by "
                         "component")
@@ -95,6 +99,8 @@ def parse_args(argv):
         parser.error("--ranks must be at least 1")
     if args.connect and args.ranks != 1:
         parser.error("--ranks is for pvbatch here; with --connect the server's ranks are used")
+    if args.beside_contour and not args.screenshot:
+        parser.error("--beside-contour needs --screenshot")
     if args.iterations < 0:
         parser.error("--iterations must be at least 0")
     args.formats = [f.strip().lower() for f in args.formats.split(",") if f.strip()]
@@ -104,39 +110,96 @@ def parse_args(argv):
     return args
 
 
-def render(source, args, ranks):
+def new_view(size):
     from paraview import simple
     view = simple.CreateRenderView()
-    view.ViewSize = [1200, 900]
+    view.ViewSize = size
     view.OrientationAxesVisibility = 1
     view.Background = [0.11, 0.12, 0.15]
     try:
         view.UseColorPaletteForBackground = 0
     except AttributeError:
         pass
+    return view
+
+
+def show_surface(source, view, color_by="solid"):
+    from paraview import simple
     display = simple.Show(source, view)
-    if args.color_by == "solid":
+    if color_by == "solid":
         if display.ColorArrayName[1]:
             simple.ColorBy(display, None)
         display.DiffuseColor = [0.93, 0.89, 0.80]
         display.AmbientColor = [0.93, 0.89, 0.80]
     else:
-        name = "RankId" if args.color_by == "rank" else "ComponentId"
+        name = "RankId" if color_by == "rank" else "ComponentId"
         simple.ColorBy(display, ("CELLS", name))
         display.RescaleTransferFunctionToDataRange(True, False)
-    # From the front (+y, the phantom's face), to the right and above, z up.
-    bounds = source.GetDataInformation().GetBounds()
+    return display
+
+
+def aim(view, bounds):
+    """From the front (+y, a CT's face), to the right and above, z up."""
+    import math
     centre = [(bounds[2 * a] + bounds[2 * a + 1]) / 2 for a in range(3)]
-    size = max(bounds[2 * a + 1] - bounds[2 * a] for a in range(3))
+    radius = 0.5 * math.sqrt(sum((bounds[2 * a + 1] - bounds[2 * a]) ** 2 for a in range(3)))
+    # Far enough for the bounding sphere to fill the view angle, as ResetCamera places it.
+    direction = [1.2, 2.0, 0.9]
+    norm = math.sqrt(sum(d * d for d in direction))
+    distance = radius / math.sin(math.radians(view.CameraViewAngle / 2))
     view.CameraFocalPoint = centre
-    view.CameraPosition = [centre[0] + 1.2 * size, centre[1] + 2.0 * size, centre[2] + 0.9 * size]
+    view.CameraPosition = [c + distance * d / norm for c, d in zip(centre, direction)]
     view.CameraViewUp = [0, 0, 1]
-    view.ResetCamera()
-    directory = os.path.dirname(os.path.abspath(args.screenshot))
-    os.makedirs(directory, exist_ok=True)
+
+
+def render(source, args, ranks):
+    from paraview import simple
+    view = new_view([1200, 900])
+    display = show_surface(source, view, args.color_by)
+    aim(view, source.GetDataInformation().GetBounds())
+    os.makedirs(os.path.dirname(os.path.abspath(args.screenshot)), exist_ok=True)
     simple.SaveScreenshot(args.screenshot, view, ImageResolution=[1200, 900])
     simple.Delete(display)
     simple.Delete(view)
+
+
+def render_beside_contour(volume, array, source, args):
+    """Contour of the whole volume (left) beside the extracted surface with its seeds (right),
+    seen by the same camera."""
+    from paraview import simple
+    contour = simple.Contour(Input=volume, ContourBy=["POINTS", array],
+                             Isosurfaces=[args.isovalue], ComputeScalars=0)
+    contour.UpdatePipeline()
+    bounds = contour.GetDataInformation().GetBounds()
+    size = max(bounds[2 * a + 1] - bounds[2 * a] for a in range(3))
+    left, right = new_view([1000, 900]), new_view([1000, 900])
+    shown = [(show_surface(contour, left), left), (show_surface(source, right), right)]
+    for seed in args.seed:
+        ball = simple.Sphere(Center=seed, Radius=0.025 * size, ThetaResolution=32,
+                             PhiResolution=32)
+        display = simple.Show(ball, right)
+        display.DiffuseColor = display.AmbientColor = [0.85, 0.15, 0.1]
+        shown.append((display, right))
+    titles = ["Contour at %g: every surface at that value" % args.isovalue,
+              "RGMC, %d seed%s: the structure through %s" % (
+                  len(args.seed), "" if len(args.seed) == 1 else "s",
+                  "it" if len(args.seed) == 1 else "them")]
+    for view, title in zip((left, right), titles):
+        text = simple.Text(Text=title)
+        display = simple.Show(text, view)
+        display.FontSize = 20
+        display.WindowLocation = "Upper Center"
+        shown.append((display, view))
+    aim(left, bounds)
+    aim(right, bounds)
+    layout = simple.CreateLayout("RGMC beside Contour")
+    layout.SplitHorizontal(0, 0.5)
+    simple.AssignViewToLayout(view=left, layout=layout, hint=1)
+    simple.AssignViewToLayout(view=right, layout=layout, hint=2)
+    os.makedirs(os.path.dirname(os.path.abspath(args.screenshot)), exist_ok=True)
+    simple.SaveScreenshot(args.screenshot, layout, ImageResolution=[2000, 900])
+    for display, view in shown:
+        simple.Hide(display.Input, view)
 
 
 def main(argv):
@@ -246,7 +309,10 @@ def main(argv):
         path = args.output + "." + extension
         simple.SaveData(path, proxy=repaired, FileType="Binary")
         report["outputs"].append(path)
-    if args.screenshot:
+    if args.screenshot and args.beside_contour:
+        render_beside_contour(volume, array, repaired, args)
+        report["outputs"].append(args.screenshot)
+    elif args.screenshot:
         render(repaired, args, ranks)
         report["outputs"].append(args.screenshot)
     with open(args.output + ".json", "w") as out:
