@@ -1389,6 +1389,14 @@ void vtkRGMarchingCubes::DescribeSurface(Run& run, vtkPolyData* output)
     wholeExtent->SetValue(i, run.whole[i]);
   }
   output->GetFieldData()->AddArray(wholeExtent);
+  // With WholeExtent, the volume's box in the world: Seam Repair closes a surface cut by it.
+  vtkNew<vtkDoubleArray> geometry;
+  geometry->SetName("VolumeGeometry");
+  geometry->SetNumberOfValues(15);
+  std::copy_n(run.geometry.Origin, 3, geometry->GetPointer(0));
+  std::copy_n(run.geometry.Spacing, 3, geometry->GetPointer(3));
+  std::copy_n(run.geometry.Direction, 9, geometry->GetPointer(6));
+  output->GetFieldData()->AddArray(geometry);
   output->GetFieldData()->AddArray(componentCount);
 
   if (run.decision.Triangles == 0)

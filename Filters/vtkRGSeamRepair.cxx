@@ -4,6 +4,7 @@
 
 #include "rgmcGrid.h"
 #include "rgmcKeyMap.h"
+#include "rgmcMeasure.h"
 #include "rgmcSmoothing.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
@@ -546,6 +547,16 @@ struct SmoothingSettings
   rgmc::SincWindow Window = rgmc::SincWindow::Nuttall;
 };
 
+/// The surface's area and the volume it encloses (closed by the volume's border planes where it
+/// is cut by them: `capArea`), in world units; the volume is NaN when the surface has a hole.
+struct Measures
+{
+  double Area = 0.0;
+  double Volume = 0.0;
+  double CapArea = 0.0;
+  bool Closable = true;
+};
+
 /// The repair of one rank's piece, with points of type T and triangles over vertex indices of
 /// type I (the input's own connectivity when its points need no merging): the seams analysed,
 /// the smoothing, the normals. Each public step is collective and returns false (on every rank,
@@ -675,6 +686,71 @@ public:
       return {};
     }
     return normals;
+  }
+
+  /// This rank's triangles' sums of twice the area and six times the volume (rgmcMeasure.h),
+  /// at `positions`, on threads: exact sums, the same for any split of the triangles.
+  rgmc::TriangleSums SumTriangles(const T* positions, const double centre[3], double scale) const
+  {
+    const vtkIdType grain = 65536;
+    const vtkIdType blocks = (this->NumTriangles + grain - 1) / grain;
+    std::vector<rgmc::TriangleSums> partial(static_cast<std::size_t>(blocks));
+    rgmc::ParallelFor(blocks, 1,
+      [&](vtkIdType first, vtkIdType last)
+      {
+        for (vtkIdType b = first; b < last; ++b)
+        {
+          partial[b].Add(positions, this->Triangles, b * grain,
+            std::min(this->NumTriangles, (b + 1) * grain), centre, scale);
+        }
+      });
+    rgmc::TriangleSums sums;
+    for (const rgmc::TriangleSums& p : partial)
+    {
+      sums.Add(p);
+    }
+    return sums;
+  }
+
+  /// This rank's triangle edges whose two ends lie on a common face of the volume (the caps'
+  /// candidates, rgmc::BorderEdge), at `positions`, packed.
+  std::vector<double> BorderEdges(const T* positions, const rgmc::VolumeBox& box) const
+  {
+    std::vector<int> faces(static_cast<std::size_t>(this->NumVertices));
+    rgmc::ParallelFor(this->NumVertices, 4096,
+      [&](vtkIdType first, vtkIdType last)
+      {
+        for (vtkIdType v = first; v < last; ++v)
+        {
+          faces[v] = this->MaskOf(v);
+        }
+      });
+    std::vector<double> packed;
+    for (vtkIdType t = 0; t < this->NumTriangles; ++t)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        const vtkIdType a = static_cast<vtkIdType>(this->Triangles[3 * t + c]);
+        const vtkIdType b = static_cast<vtkIdType>(this->Triangles[3 * t + (c + 1) % 3]);
+        if (!(faces[a] & faces[b]))
+        {
+          continue;
+        }
+        rgmc::BorderEdge e;
+        e.From = this->Numbering.Gid[a];
+        e.To = this->Numbering.Gid[b];
+        e.FromFaces = faces[a];
+        e.ToFaces = faces[b];
+        double x[3];
+        std::copy_n(positions + 3 * a, 3, x);
+        box.ToIndex(x, e.FromIndex);
+        std::copy_n(positions + 3 * b, 3, x);
+        box.ToIndex(x, e.ToIndex);
+        packed.resize(packed.size() + rgmc::BorderEdge::Words);
+        e.Pack(packed.data() + packed.size() - rgmc::BorderEdge::Words);
+      }
+    }
+    return packed;
   }
 
   std::vector<T> Smoothed; // positions of this rank's vertices after smoothing
@@ -1480,6 +1556,65 @@ private:
   std::vector<std::vector<vtkIdType>> RequestLists; // provider -> gids asked of it
 };
 
+/// The area and enclosed volume of the whole surface at `positions` (this rank's vertices),
+/// the same to the bit on every rank for any number of ranks and threads: each rank's exact
+/// sums (rgmc::ExactSum) are reduced as integers, and every rank closes the surface at the
+/// border from all ranks' border edges, in one order. An agreement, an AllReduce, an AllGather,
+/// an AllGatherV, an agreement.
+template <typename T, typename I>
+bool MeasureSurface(Ranks& ranks, const PieceRepair<T, I>& repair, const T* positions,
+  const rgmc::VolumeBox& box, Measures& measures, std::string& problem)
+{
+  double centre[3], scale;
+  box.Frame(centre, scale);
+  rgmc::TriangleSums sums;
+  std::vector<double> mine;
+  if (!ranks.Step("measure the surface", problem,
+        [&]()
+        {
+          sums = repair.SumTriangles(positions, centre, scale);
+          mine = repair.BorderEdges(positions, box);
+        }))
+  {
+    return false;
+  }
+  std::int64_t words[8], totals[8];
+  sums.TwiceArea.ToWords(words);
+  sums.SixVolume.ToWords(words + 4);
+  ranks.AllReduce(words, totals, 8, vtkCommunicator::SUM_OP, "summing the measures");
+  const vtkIdType count = static_cast<vtkIdType>(mine.size());
+  std::vector<vtkIdType> lengths(ranks.Size), offsets(ranks.Size, 0);
+  ranks.AllGather(&count, lengths.data(), 1, "counting the border edges");
+  std::partial_sum(lengths.begin(), lengths.end() - 1, offsets.begin() + 1);
+  std::vector<double> all;
+  if (!ranks.Step("gather the border edges", problem,
+        [&]() { all.resize(static_cast<std::size_t>(offsets.back() + lengths.back())); }))
+  {
+    return false;
+  }
+  ranks.AllGatherV(
+    mine.data(), all.data(), count, lengths.data(), offsets.data(), "gathering the border edges");
+  return ranks.Step("close the surface at the border", problem,
+    [&]()
+    {
+      std::vector<rgmc::BorderEdge> edges(all.size() / rgmc::BorderEdge::Words);
+      for (std::size_t e = 0; e < edges.size(); ++e)
+      {
+        edges[e] = rgmc::BorderEdge::Unpack(all.data() + e * rgmc::BorderEdge::Words);
+      }
+      const rgmc::Caps caps = rgmc::BorderCaps(std::move(edges), box);
+      const double twiceArea = rgmc::ExactSum::FromWordSums(totals).Get();
+      const double sixVolume = rgmc::ExactSum::FromWordSums(totals + 4).Get();
+      measures.Area = 0.5 * twiceArea * scale * scale;
+      // Counterclockwise in index space, as marching cubes orders triangles: a mirroring
+      // direction turns them clockwise in the world.
+      measures.Volume =
+        (box.Handedness() * sixVolume * scale * scale * scale + caps.SixVolume) / 6.0;
+      measures.CapArea = caps.Area;
+      measures.Closable = caps.Closed;
+    });
+}
+
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -1511,6 +1646,8 @@ struct vtkRGSeamRepair::Run
   LocalVertices vertices;
   GlobalNumbering numbering;
   BorderTest border;
+  rgmc::VolumeBox box; // the volume's, or the mesh's bounds when the input does not say
+  Measures before, after; // before and after smoothing
   bool smooth = false;
   std::vector<vtkIdType> connectivity; // the triangles over the vertices, when merged or copied
   vtkNew<vtkPoints> points;            // the output's
@@ -1530,7 +1667,7 @@ struct vtkRGSeamRepair::Run
 //  PASS 1 NumberVertices  AllReduce (whether every rank has vertex keys), agreement (the
 //                         local sort); IdentityNumbering: AllGather, AllGatherV, agreement,
 //                         exchange, agreement, AllGather, exchange, agreement
-//  PASS 2 FindBorder      2 AllReduce (the bounds)
+//  PASS 2 FindBorder      3 AllReduce (the bounds, whether every rank has the volume's box)
 //  PASS 3 RepairSeams     agreement (the input copied); AnalyzeSeams: agreement, exchange,
 //                         agreement, exchange, agreement
 //  PASS 4                 smoothing only: per iteration an AllReduce (abort) and two
@@ -1686,6 +1823,33 @@ void vtkRGSeamRepair::FindBorder(Run& run)
       border.Whole[i] = whole->GetValue(i);
     }
   }
+  // The box that closes a surface cut by the border: the volume's (vtkRGMarchingCubes says
+  // where it is), else the bounds of the whole mesh.
+  // Every rank must take the same box, ranks without points included.
+  vtkDoubleArray* geometry =
+    vtkDoubleArray::SafeDownCast(input->GetFieldData()->GetArray("VolumeGeometry"));
+  const int described = whole && whole->GetNumberOfValues() == 6 && geometry &&
+      geometry->GetNumberOfValues() == 15
+    ? 1
+    : 0;
+  int allDescribed = 0;
+  run.ranks.AllReduce(
+    &described, &allDescribed, 1, vtkCommunicator::MIN_OP, "agreeing on the volume's box");
+  if (allDescribed)
+  {
+    const double* g = geometry->GetPointer(0);
+    std::copy_n(g, 3, run.box.Origin);
+    std::copy_n(g + 3, 3, run.box.Spacing);
+    std::copy_n(g + 6, 9, run.box.Direction);
+    for (int i = 0; i < 6; ++i)
+    {
+      run.box.Extent[i] = whole->GetValue(i);
+    }
+  }
+  else
+  {
+    std::copy_n(border.Bounds, 6, run.box.Extent);
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -1724,10 +1888,12 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
   }
   PieceRepair<T, I> repair(ranks, run.vertices, run.numbering, run.border, run.keys, positions,
     triangles, run.input->GetNumberOfPolys());
-  if (!repair.AnalyzeSeams(run.smooth, run.checks, run.problem))
+  if (!repair.AnalyzeSeams(run.smooth, run.checks, run.problem) ||
+    !MeasureSurface(ranks, repair, positions, run.box, run.before, run.problem))
   {
     return false;
   }
+  run.after = run.before;
   this->UpdateProgress(0.4);
   if (run.smooth)
   {
@@ -1749,7 +1915,8 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
       return false;
     }
     run.normals = repair.Normals(run.problem);
-    if (run.normals.empty() && run.vertices.Count > 0)
+    if ((run.normals.empty() && run.vertices.Count > 0) ||
+      !MeasureSurface(ranks, repair, repair.Smoothed.data(), run.box, run.after, run.problem))
     {
       return false;
     }
@@ -1877,6 +2044,21 @@ void vtkRGSeamRepair::ReportChecks(Run& run, vtkPolyData* output)
   add("NonManifoldEdges", sums.NonManifold);
   add("EulerCharacteristic", euler);
   add("Closed", closed ? 1 : 0);
+  // The measures: the volume needs a surface without holes (closed, or cut by the border only).
+  const bool enclosing = sums.Boundary == 0 && run.before.Closable && run.after.Closable;
+  auto addMeasure = [fd](const char* name, double value)
+  {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name);
+    a->InsertNextValue(value);
+    fd->AddArray(a);
+  };
+  const double nan = vtkMath::Nan();
+  addMeasure("SurfaceArea", run.after.Area);
+  addMeasure("EnclosedVolume", enclosing ? run.after.Volume : nan);
+  addMeasure("BorderCapArea", enclosing ? run.after.CapArea : nan);
+  addMeasure("SurfaceAreaBeforeSmoothing", run.before.Area);
+  addMeasure("EnclosedVolumeBeforeSmoothing", enclosing ? run.before.Volume : nan);
   if (run.ranks.Rank == 0)
   {
     vtkLogF(INFO,
@@ -1886,6 +2068,9 @@ void vtkRGSeamRepair::ReportChecks(Run& run, vtkPolyData* output)
       static_cast<long long>(sums.Edges), static_cast<long long>(sums.Boundary),
       static_cast<long long>(sums.Border), static_cast<long long>(sums.NonManifold),
       static_cast<long long>(euler), closed ? "closed" : "not closed");
+    vtkLogF(INFO, "Seam repair: area %.10g, enclosed volume %.10g (before smoothing %.10g, %.10g).",
+      run.after.Area, enclosing ? run.after.Volume : nan, run.before.Area,
+      enclosing ? run.before.Volume : nan);
   }
 }
 
