@@ -25,6 +25,9 @@ import rgmc_common  # noqa: E402
 
 MODES = {"seeded": "Seeded", "largest": "Largest Component", "all": "All Components"}
 SMOOTHING = {"laplacian": "Laplacian", "sinc": "Windowed Sinc", "none": "None"}
+MEASURES = {"area": "SurfaceArea", "volume": "EnclosedVolume", "border_cap_area": "BorderCapArea",
+            "area_before_smoothing": "SurfaceAreaBeforeSmoothing",
+            "volume_before_smoothing": "EnclosedVolumeBeforeSmoothing"}
 CHECKS = ["UniquePoints", "Triangles", "Edges", "BoundaryEdges", "VolumeBorderEdges",
           "NonManifoldEdges", "EulerCharacteristic", "Closed"]
 
@@ -108,6 +111,44 @@ def parse_args(argv):
         if f not in ("stl", "ply", "vtp"):
             parser.error("--formats takes stl, ply and vtp, not %r" % f)
     return args
+
+
+def measures(fields, medical):
+    """Seam Repair's area and enclosed volume (JSON-ready: null for no volume), in the data's
+    units: mm for DICOM, NIfTI and the phantom, with the volume in ml too."""
+    import math
+    values = {}
+    for key, name in MEASURES.items():
+        value = fields.GetArrayInformation(name).GetComponentRange(0)[0]
+        values[key] = None if math.isnan(value) else value
+    values["units"] = "mm" if medical else "the data's units"
+    if medical:
+        for key in ("volume", "volume_before_smoothing"):
+            if values[key] is not None:
+                values[key + "_ml"] = values[key] / 1000.0
+    return values
+
+
+def describe_measures(m):
+    """One line: area and volume after smoothing, before smoothing, and the border's part."""
+    area, volume = ("mm^2", "mm^3") if m["units"] == "mm" else ("units^2", "units^3")
+
+    def vol(key):
+        if m[key] is None:
+            return "no enclosed volume (the surface has a hole inside the volume)"
+        ml = " (%.2f ml)" % (m[key] / 1000.0) if m["units"] == "mm" else ""
+        return "volume %.6g %s%s" % (m[key], volume, ml)
+
+    text = "area %.6g %s, %s" % (m["area"], area, vol("volume"))
+    if m["area_before_smoothing"] != m["area"] or m["volume_before_smoothing"] != m["volume"]:
+        text += "; before smoothing area %.6g %s, %s" % (
+            m["area_before_smoothing"], area, vol("volume_before_smoothing"))
+        if m["volume"] and m["volume_before_smoothing"]:
+            text += " (smoothing changed it by %+.2f%%)" % (
+                100.0 * (m["volume"] / m["volume_before_smoothing"] - 1.0))
+    if m["border_cap_area"]:
+        text += "; closed across the volume's border by %.6g %s" % (m["border_cap_area"], area)
+    return text
 
 
 def new_view(size):
@@ -301,6 +342,8 @@ def main(argv):
               "closed" if checks["Closed"] else "not closed"))
     print("smoothing:  %s, %d iterations (%.3f s with the seam repair)" % (
         args.smooth, args.iterations, report["repair_seconds"]))
+    report["measures"] = measures(fields, medical=bool(summary) or args.input.startswith("phantom:"))
+    print("measures:   %s" % describe_measures(report["measures"]))
 
     directory = os.path.dirname(os.path.abspath(args.output))
     os.makedirs(directory, exist_ok=True)

@@ -62,7 +62,8 @@ def main():
     result = run(command)
     check(result.returncode == 0, "the pipeline succeeds")
     for expected in ("input:", "72 x 72 x 72", "isovalue:   400", "seed:       (0, 0, 105)",
-                     "triangles", "seconds:", "mesh:", "closed", "smoothing:  laplacian, 20"):
+                     "triangles", "seconds:", "mesh:", "closed", "smoothing:  laplacian, 20",
+                     "measures:   area", "before smoothing"):
         check(expected in result.stdout, "the summary says %r" % expected)
     report = json.load(open(prefix + ".json"))
     check(report["triangles"] > 10000, "the skull has many triangles: %d" % report["triangles"])
@@ -87,6 +88,13 @@ def main():
     check(report2["ranks"] == 2 and report2["triangles"] == report["triangles"],
           "2 ranks give the same triangles: %d vs %d" % (report2["triangles"], report["triangles"]))
     check(report2["checks"] == checks, "2 ranks give the same mesh checks: %s" % report2["checks"])
+    # The measures, to the bit (JSON keeps a double's every digit): smoothing shrank the skull.
+    measures = report["measures"]
+    check(report2["measures"] == measures, "2 ranks give the same measures: %s vs %s" % (
+        report2["measures"], measures))
+    check(measures["volume"] is not None and 0 < measures["volume"] < measures["volume_before_smoothing"]
+          and measures["border_cap_area"] == 0,
+          "the closed skull encloses a volume that Laplacian smoothing shrinks: %s" % measures)
     check(stl_triangles(prefix + "-2.stl") == report["triangles"], "the 2-rank STL holds every triangle")
     check(ply_vertices(prefix + "-2.ply") == checks["UniquePoints"],
           "the 2-rank PLY has no duplicate vertex: %d vs %d unique" % (
@@ -101,6 +109,11 @@ def main():
                      "Facets with 3 disconnected edges"):
             check(re.search(line + r"\s*:\s*0\s", out) is not None, "admesh: %s is not 0" % line)
         check(re.search(r"Number of parts\s*:\s*1\s", out) is not None, "admesh: one part")
+        # admesh's volume of the STL (float facets, summed in float: about 1e-6 relative).
+        found = re.search(r"Volume\s*:\s*([0-9.eE+-]+)", out)
+        enclosed = report2["measures"]["volume"]
+        check(found is not None and abs(float(found.group(1)) - enclosed) <= 1e-5 * enclosed,
+              "admesh's volume %s, the report's %s" % (found and found.group(1), enclosed))
 
     # Bad input: clear messages and a non-zero exit, nothing written.
     cases = [
