@@ -241,6 +241,7 @@ def render_beside_contour(volume, array, source, args):
     simple.SaveScreenshot(args.screenshot, layout, ImageResolution=[2000, 900])
     for display, view in shown:
         simple.Hide(display.Input, view)
+    return contour.GetDataInformation().GetNumberOfCells()
 
 
 def main(argv):
@@ -353,8 +354,11 @@ def main(argv):
         simple.SaveData(path, proxy=repaired, FileType="Binary")
         report["outputs"].append(path)
     if args.screenshot and args.beside_contour:
-        render_beside_contour(volume, array, repaired, args)
+        report["contour_triangles"] = render_beside_contour(volume, array, repaired, args)
         report["outputs"].append(args.screenshot)
+        print("contour:    ParaView's Contour at %g gives %d triangles: every surface at that "
+              "value (left in the picture), %d of them the structure's" % (
+                  args.isovalue, report["contour_triangles"], triangles))
     elif args.screenshot:
         render(repaired, args, ranks)
         report["outputs"].append(args.screenshot)

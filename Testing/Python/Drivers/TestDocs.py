@@ -27,8 +27,8 @@ from rgmc_testing import check, finish, run, xvfb_run  # noqa: E402
 README_MAX_LINES = 300
 # The README's set-up commands, exactly as a newcomer types them.
 SETUP_COMMANDS = [
-    "./rgmc demo    # install what is missing, build, make the default CT phantom, "
-    "extract its skull on 2 MPI ranks",
+    "./rgmc demo    # install what is missing, build, read a real head CT, extract its skull "
+    "on 2 MPI ranks",
     "./rgmc test    # install what is missing, build, run the whole test suite",
 ]
 EXAMPLES_PARAVIEW = "paraview-5.11"
