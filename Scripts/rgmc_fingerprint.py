@@ -30,7 +30,7 @@ def digest_array(h, array):
         h.update(vtk_to_numpy(array).tobytes())
 
 
-def digest_polydata(data):
+def digest_polydata(data, ignore=()):
     h = hashlib.sha256()
     points = data.GetPoints()
     digest_array(h, points.GetData() if points else None)
@@ -41,7 +41,8 @@ def digest_polydata(data):
         digest_array(h, polys.GetConnectivityArray())
     for attributes in (data.GetPointData(), data.GetCellData(), data.GetFieldData()):
         for i in range(attributes.GetNumberOfArrays()):
-            digest_array(h, attributes.GetAbstractArray(i))
+            if attributes.GetAbstractArray(i).GetName() not in ignore:
+                digest_array(h, attributes.GetAbstractArray(i))
     return h.hexdigest()
 
 
@@ -50,6 +51,9 @@ def main():
     parser.add_argument("--plugin", required=True)
     parser.add_argument("--out", required=True)
     parser.add_argument("--size", type=int, default=96)
+    parser.add_argument("--ignore", default="",
+                        help="comma-separated arrays left out of the digests (to compare with a "
+                        "build that did not make them)")
     args = parser.parse_args()
     simple.LoadPlugin(os.path.abspath(args.plugin), ns=vars(simple))  # 5.13+: no relative path
     controller = servermanager.vtkProcessModule.GetProcessModule().GetGlobalController()
@@ -64,7 +68,7 @@ def main():
         data = proxy.GetClientSideObject().GetOutputDataObject(0)
         lines.append("%s rank %d of %d: %d points %d triangles %s" % (
             name, rank, ranks, data.GetNumberOfPoints(), data.GetNumberOfPolys(),
-            digest_polydata(data)))
+            digest_polydata(data, args.ignore.split(","))))
 
     surfaces = {}
     for mode in ("Seeded", "Largest Component", "All Components"):
