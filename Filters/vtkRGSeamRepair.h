@@ -16,6 +16,12 @@
  *   `VolumeBorderEdges`, `NonManifoldEdges`, `EulerCharacteristic`, `Closed`) and in the log:
  *   a closed surface has no boundary and no non-manifold edge; edges where the surface leaves
  *   the volume are counted apart (`VolumeBorderEdges`).
+ * - Measures, in field data and in the log: `SurfaceArea` and `EnclosedVolume` of the output,
+ *   and the same `...BeforeSmoothing`, in world units, the same to the bit on any number of
+ *   ranks and threads (exact fixed-point sums, rgmcMeasure.h). A surface cut by the volume's
+ *   border is closed by the border planes (their part: `BorderCapArea`; the box is the volume's
+ *   when the input carries vtkRGMarchingCubes' `WholeExtent` and `VolumeGeometry`, else the
+ *   mesh's bounds); a surface with a hole inside the volume has a NaN volume.
  * - Smoothing that does not see the seams: Laplacian in Jacobi form (default; 20 iterations,
  *   relaxation 0.01, as Wei et al. use) or windowed sinc (Taubin; the smoother without
  *   shrinkage, as vtkWindowedSincPolyDataFilter computes it on the merged mesh), with the
@@ -43,6 +49,9 @@
  *    come from the triangles around them on their own rank.
  * 4. Each smoothing iteration sends, from the ranks that hold them, the neighbour positions
  *    owners need, then the owners' new positions to the other holders.
+ * 5. The measures, before and after smoothing: each rank's exact sums are reduced; the few
+ *    triangle edges on the volume's border are gathered on every rank, which closes the
+ *    surface there in one order.
  * Sorted arrays throughout (no per-vertex maps); memory on a rank is proportional to its own
  * piece. Errors are collective: a problem on one rank, a failed allocation included, is
  * reported by every rank, and the output is empty.
