@@ -6,7 +6,9 @@
 // - before smoothing, the area equals the sum of the output triangles' areas and the volume
 //   equals the volume of the surface closed by the border planes, computed independently: the
 //   signed volume of the triangles about a point on every cutting plane (the cones over the
-//   caps from there are flat), or the slab's exact volume where no such point exists;
+//   caps from there are flat), the slab's exact volume where no such point exists, or, for
+//   blobs cut by every face, the triangles' signed volume about the centre plus the cones over
+//   caps found by marching squares on the faces;
 // - every measure, before and after each smoothing, is the same to the bit on any number of
 //   ranks and decompositions as on one rank (and on any number of threads: UpdateAtThreads);
 // - Laplacian smoothing shrinks the volume, windowed sinc less;
@@ -24,6 +26,7 @@
 #include "vtkPolyData.h"
 #include "vtkRGSeamRepair.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <iostream>
@@ -72,7 +75,8 @@ struct Case
   int Direction;
   bool HasApex;        // a point on every cutting plane: the oracle's apex
   double Apex[3];      // in index space
-  double ExactVolume;  // when !HasApex: the exact volume in index units (times the voxel's)
+  double ExactVolume;  // when !HasApex: the exact volume in index units (times the voxel's),
+                       // or 0: the caps by marching squares on the faces (FaceCapsOracle)
 };
 
 std::vector<Case> Cases()
@@ -105,7 +109,100 @@ std::vector<Case> Cases()
   // Everything above k = 10.3: its cap on face z+ has no edge of the mesh on it.
   cases.push_back(Case{ "half space reaching face z+",
     [](int, int, int k) { return k - 10.3; }, 2, false, { 0, 0, 0 }, 32.0 * 32.0 * 21.7 });
+  // Many blobs, cut by every face, with caps meeting at the volume's edges and corners.
+  for (int seed : { 5, 17 })
+  {
+    const std::function<double(int, int, int)> blobs = Blobs(Whole, 40, seed);
+    cases.push_back(Case{ "blobs cut by every face, seed " + std::to_string(seed),
+      [blobs](int i, int j, int k) { return blobs(i, j, k) - 0.3; }, 0, false, { 0, 0, 0 }, 0 });
+  }
   return cases;
+}
+
+/// The caps of an All Components surface on the six faces of the volume, by marching squares:
+/// on each face cell, the polygon of its corners inside (field >= 0) and the crossings on its
+/// edges (linear, as marching cubes places them), in index units. Returns the volume the caps
+/// add (their cones from the volume's centre) in world units, and in `slack` a bound on the
+/// part that saddle cells (two opposite corners inside) leave open: marching cubes joins or
+/// separates their corners by its case table, this oracle takes the smaller polygon.
+double FaceCapsOracle(const Case& c, double& capArea, double& slack, double& areaSlack, int& faces)
+{
+  double volume = 0.0;
+  capArea = 0.0;
+  slack = 0.0;
+  areaSlack = 0.0;
+  faces = 0;
+  for (int face = 0; face < 6; ++face)
+  {
+    const int axis = face / 2, u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const int fixed = Whole[face];
+    double area = 0.0, saddles = 0.0;
+    for (int a = Whole[2 * u]; a < Whole[2 * u + 1]; ++a)
+    {
+      for (int b = Whole[2 * v]; b < Whole[2 * v + 1]; ++b)
+      {
+        double corner[4][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } }, f[4];
+        for (int q = 0; q < 4; ++q)
+        {
+          int index[3];
+          index[axis] = fixed;
+          index[u] = a + static_cast<int>(corner[q][0]);
+          index[v] = b + static_cast<int>(corner[q][1]);
+          f[q] = c.Field(index[0], index[1], index[2]);
+        }
+        std::vector<std::array<double, 2>> polygon;
+        for (int q = 0; q < 4; ++q)
+        {
+          const int r = (q + 1) % 4;
+          if (f[q] >= 0)
+          {
+            polygon.push_back({ corner[q][0], corner[q][1] });
+          }
+          if ((f[q] >= 0) != (f[r] >= 0))
+          {
+            const double t = f[q] / (f[q] - f[r]);
+            polygon.push_back({ corner[q][0] + t * (corner[r][0] - corner[q][0]),
+              corner[q][1] + t * (corner[r][1] - corner[q][1]) });
+          }
+        }
+        double twice = 0.0;
+        for (std::size_t p = 0; p < polygon.size(); ++p)
+        {
+          const auto& x = polygon[p];
+          const auto& y = polygon[(p + 1) % polygon.size()];
+          twice += x[0] * y[1] - x[1] * y[0];
+        }
+        const bool saddle = (f[0] >= 0) == (f[2] >= 0) && (f[1] >= 0) == (f[3] >= 0) &&
+          (f[0] >= 0) != (f[1] >= 0);
+        if (saddle)
+        {
+          saddles += 1.0; // at most the whole cell is in doubt
+          // The hexagon joins the two inside corners; the separated reading is two triangles,
+          // whose area the hexagon's exceeds: take the triangles, the difference is slack.
+          double triangles = 0.0;
+          for (int q = 0; q < 4; ++q)
+          {
+            if (f[q] >= 0)
+            {
+              const int prev = (q + 3) % 4, next = (q + 1) % 4;
+              const double s = f[q] / (f[q] - f[next]), w = f[q] / (f[q] - f[prev]);
+              triangles += s * w; // a right triangle in the unit cell: legs s and w
+            }
+          }
+          twice = triangles;
+        }
+        area += 0.5 * twice;
+      }
+    }
+    const double cell = Spacing[u] * Spacing[v];
+    const double distance = 0.5 * (Whole[2 * axis + 1] - Whole[2 * axis]) * Spacing[axis];
+    volume += distance * area * cell / 3.0;
+    capArea += area * cell;
+    slack += distance * saddles * cell / 3.0;
+    areaSlack += saddles * cell;
+    faces += area > 0;
+  }
+  return volume;
 }
 
 FieldMaker Maker(const Case& c)
@@ -217,13 +314,27 @@ void Check(vtkMultiProcessController* controller, const Case& c)
       if (method == 0)
       {
         // Unsmoothed: the measures against an independent computation on the same mesh.
-        double apex[3], area, volume;
-        World(c.Direction, c.Apex, apex);
+        double apex[3], area, volume, caps = 0.0, capArea = 0.0, slack = 0.0, areaSlack = 0.0;
+        int capped = 0;
+        const bool faces = !c.HasApex && c.ExactVolume == 0.0;
+        if (faces)
+        {
+          // About the volume's centre: the caps add their cones from there.
+          const double centre[3] = { 16, 16, 16 };
+          World(c.Direction, centre, apex);
+          caps = FaceCapsOracle(c, capArea, slack, areaSlack, capped);
+          RGMC_CHECK(capped == 6, c.Name << ": caps on " << capped << " faces, not all six");
+        }
+        else
+        {
+          World(c.Direction, c.Apex, apex);
+        }
         Oracle(out, apex, area, volume);
         const double voxel = Spacing[0] * Spacing[1] * Spacing[2];
         // A mirroring direction turns marching cubes' triangles clockwise in the world.
-        const double expected = c.HasApex ? (c.Direction == 2 ? -volume : volume)
-                                          : c.ExactVolume * voxel;
+        const double expected = faces ? volume + caps
+          : c.HasApex                 ? (c.Direction == 2 ? -volume : volume)
+                                      : c.ExactVolume * voxel;
         // Sums of about 10^4 float points' terms in double: 1e-9 relative. The points are
         // float: on a rotated plane a vertex lies up to half an ulp of its coordinates off it,
         // which tilts the oracle's cones over the caps by as much (a third of the caps' area
@@ -240,9 +351,11 @@ void Check(vtkMultiProcessController* controller, const Case& c)
           largest = std::max({ largest, std::abs(x[0]), std::abs(x[1]), std::abs(x[2]) });
         }
         const double offPlane = c.Direction ? std::ldexp(largest, -24) : 0.0;
-        const double tolerance = c.HasApex
-          ? 1e-9 * std::abs(expected) + m.Values[2] * offPlane / 3.0
-          : 1e-6 * std::abs(expected);
+        // The marching squares caps: computed in double from the field, where marching
+        // cubes' vertices are float (1e-6 of the caps' cones), and the saddle cells' slack.
+        const double tolerance = faces ? 1e-9 * std::abs(expected) + 1e-6 * caps + slack
+          : c.HasApex                  ? 1e-9 * std::abs(expected) + m.Values[2] * offPlane / 3.0
+                                       : 1e-6 * std::abs(expected);
         RGMC_CHECK(std::abs(m.Values[0] - area) <= 1e-9 * area,
           c.Name << ": area " << m.Values[0] << ", the triangles' " << area);
         RGMC_CHECK(m.Values[0] == m.Values[3], c.Name << ": unsmoothed area before and after");
@@ -250,6 +363,12 @@ void Check(vtkMultiProcessController* controller, const Case& c)
           c.Name << ": enclosed volume " << m.Values[1] << ", expected " << expected);
         RGMC_CHECK((m.Values[2] > 0) == (c.Name != "closed sphere"),
           c.Name << ": border cap area " << m.Values[2]);
+        if (faces)
+        {
+          RGMC_CHECK(std::abs(m.Values[2] - capArea) <= 1e-6 * capArea + areaSlack,
+            c.Name << ": border cap area " << m.Values[2] << ", by marching squares " << capArea
+                   << " (saddle cells: " << areaSlack << ")");
+        }
         std::cout.precision(15);
         std::cout << c.Name << ": area " << m.Values[0] << ", volume " << m.Values[1]
                   << " (expected " << expected << "), caps " << m.Values[2] << "\n";
