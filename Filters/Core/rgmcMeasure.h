@@ -2,9 +2,9 @@
 // threads, without VTK.
 //
 // Each triangle's terms (twice its area, and six times the signed volume of the tetrahedron it
-// makes with the volume's centre) are rounded once to fixed point (ExactSum: 128 bits, 2^-90 of
-// the mesh's scale), so that sums over any split of the triangles, in any order, are the same
-// integers.
+// makes with the volume's centre) are rounded once to fixed point (ExactSum: 2^-60 of the
+// mesh's scale, summed in 128 bits), so that sums over any split of the triangles, in any
+// order, are the same integers.
 //
 // A surface cut by the volume's border is closed by the border planes (BorderCaps): on each face
 // of the volume's box, the cap is the part of the face inside the structure, bounded by the
@@ -20,18 +20,28 @@
 namespace rgmc
 {
 
-/// A sum of doubles that does not depend on their order: each term is rounded to a multiple of
-/// 2^-FractionBits and summed as a 128-bit integer (modulo 2^128, exact while the true sum fits:
-/// |sum| < 2^(127 - FractionBits), terms below 2 and up to 2^36 of them).
+/// A sum of doubles that does not depend on their order: each term is rounded (toward zero) to
+/// a multiple of 2^-FractionBits and summed as a 128-bit integer (modulo 2^128, exact while the
+/// true sum fits: |sum| < 2^(127 - FractionBits)). Terms below 8 in magnitude, as the measures'
+/// are, take one conversion to a 64-bit integer; larger ones go through 128 bits.
 class ExactSum
 {
 public:
-  static constexpr int FractionBits = 90;
+  static constexpr int FractionBits = 60;
 
   void Add(double term)
   {
-    this->Value += static_cast<unsigned __int128>(
-      static_cast<__int128>(std::ldexp(term, FractionBits)));
+    constexpr double one = static_cast<double>(std::int64_t(1) << FractionBits);
+    const double scaled = term * one; // a power of two: exact
+    if (std::fabs(term) < 8.0)
+    {
+      this->Value +=
+        static_cast<unsigned __int128>(static_cast<__int128>(static_cast<std::int64_t>(scaled)));
+    }
+    else
+    {
+      this->Value += static_cast<unsigned __int128>(static_cast<__int128>(scaled));
+    }
   }
   void Add(const ExactSum& other) { this->Value += other.Value; }
 
