@@ -1,7 +1,9 @@
 """A real patient: the head CT of Debian's invesalius-examples (Cranium.inv3, an InVesalius 3
 project), as the demo runs it.
 
-- Scripts/rgmc_inv3.py reads the project (its volume and spacing as main.plist says);
+- Scripts/rgmc_inv3.py reads the project (its volume and spacing as main.plist says), and
+  refuses broken copies of it (not a tar, no main.plist, a short volume, an unknown dtype, no
+  spacing) with a message naming the problem;
 - the generator writes it as a DICOM series (one file per slice, rescaled, shuffled names);
 - on 1 to 4 ranks (pvbatch under mpiexec, InParaView/CraniumChecks.py), the plugin's reader
   reads the series and the skull seeded at the top of the head at 299.5 HU is exactly
@@ -31,6 +33,51 @@ from rgmc_testing import (check, finish, in_paraview, mpi_environment, mpiexec_c
 INVESALIUS_VOLUME = 657705.59515678  # mm^3, as surface_0.plist records it
 
 
+def broken_projects(workdir, cranium, rgmc_inv3):
+    """The project reader's errors: each broken copy of Cranium.inv3 is refused, naming why."""
+    import io
+    import tarfile
+    with tarfile.open(cranium, "r:*") as tar:
+        members = {m.name: tar.extractfile(m).read() for m in tar.getmembers() if m.isfile()}
+    main_plist = [n for n in members if n.endswith("main.plist")][0]
+    matrix = [n for n in members if n.endswith("matrix.dat")][0]
+
+    def write(name, changed):
+        path = os.path.join(workdir, name + ".inv3")
+        with tarfile.open(path, "w:gz") as out:
+            for member, data in changed.items():
+                info = tarfile.TarInfo(member)
+                info.size = len(data)
+                out.addfile(info, io.BytesIO(data))
+        return path
+
+    text = members[main_plist]
+    cases = [
+        ("not-a-project", None, "is not an InVesalius 3 project"),
+        ("no-main", {k: v for k, v in members.items() if k != main_plist}, "main.plist files, not one"),
+        ("short-matrix", dict(members, **{matrix: members[matrix][:-2]}), "holds 14155774 bytes"),
+        ("bad-dtype", dict(members, **{main_plist: text.replace(b"<string>int16</string>",
+                                                                 b"<string>complex64</string>")}),
+         "dtype 'complex64'"),
+        ("no-spacing", dict(members, **{main_plist: text.replace(b"<key>spacing</key>",
+                                                                  b"<key>spacings</key>")}),
+         "lacks the volume's dtype, shape, filename or spacing"),
+    ]
+    for name, changed, message in cases:
+        if changed is None:
+            path = os.path.join(workdir, name + ".inv3")
+            with open(path, "wb") as out:
+                out.write(b"not a tar at all")
+        else:
+            path = write(name, changed)
+        try:
+            rgmc_inv3.Project(path).volume()
+            check(False, "%s: read without an error" % name)
+        except rgmc_inv3.ProjectError as error:
+            check(message in str(error), "%s: the error %r does not say %r" % (name, str(error),
+                                                                               message))
+
+
 def main():
     parser = argparse.ArgumentParser()
     for name in ("--pvbatch", "--mpiexec", "--plugin", "--scripts", "--cranium", "--workdir"):
@@ -54,6 +101,7 @@ def main():
           "the project's volume: %s" % summary)
     check(summary["surfaces"][0]["volume_mm3"] == INVESALIUS_VOLUME,
           "InVesalius's bone surface records %s mm^3" % summary["surfaces"][0]["volume_mm3"])
+    broken_projects(args.workdir, args.cranium, rgmc_inv3)
     vtp = os.path.join(args.workdir, "invesalius-bone.vtp")
     project.extract_surface(0, vtp)
 
