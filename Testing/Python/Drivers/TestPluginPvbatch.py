@@ -82,7 +82,13 @@ def main():
 
     # An isovalue of 0 given at creation stays 0: ParaView resets a property whose value a
     # script sets equal to its XML default to the domain's default (here the middle of the data
-    # range) after creation; Isovalue has no XML default, so it is never reset.
+    # range) after creation; Isovalue's XML default is a value no one types. Without an
+    # Isovalue, the filter starts at the middle of the range, as Contour does.
+    default = RGMarchingCubes(Input=phantom, ContourBy=["POINTS", "HU"])  # noqa: F821
+    low, high = phantom.PointData["HU"].GetRange()
+    check(default.Isovalue == (low + high) / 2, "without Isovalue: %s, not the middle of %s..%s"
+          % (default.Isovalue, low, high))
+    simple.Delete(default)
     water = RGMarchingCubes(Input=phantom, ContourBy=["POINTS", "HU"], Isovalue=0,  # noqa: F821
                             ExtractionMode="All Components")
     water.UpdatePipeline()
