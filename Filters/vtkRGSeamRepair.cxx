@@ -663,6 +663,7 @@ public:
           {
             sums.assign(3 * this->NumVertices, 0.0);
             this->CornersAround(this->CornerOffsets, this->Corners);
+            this->ComputeTriangleCrosses();
             this->ListSharedTerms(toOwners);
           }))
     {
@@ -679,6 +680,7 @@ public:
     {
       return {};
     }
+    std::vector<double>().swap(this->TriangleCross);
     this->Update(sums.data(), NormalBackTag);
     if (!this->AllRanks.Step(
           "compute normals", problem, [&]() { normals.assign(sums.begin(), sums.end()); }))
@@ -1279,26 +1281,45 @@ private:
 
   // -- normals -----------------------------------------------------------------------------
 
+  /// Each triangle's area vector at the smoothed positions, taken from its corner of smallest
+  /// global id (orientation kept): the same bits whichever vertex or rank asks. Once per
+  /// triangle, on threads (the stencils' memory, released, holds it).
+  void ComputeTriangleCrosses()
+  {
+    this->TriangleCross.resize(static_cast<std::size_t>(3 * this->NumTriangles));
+    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
+    const T* x = this->Smoothed.data();
+    rgmc::ParallelFor(this->NumTriangles, 16384,
+      [&](vtkIdType firstTriangle, vtkIdType lastTriangle)
+      {
+        for (vtkIdType t = firstTriangle; t < lastTriangle; ++t)
+        {
+          vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
+            static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
+            static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
+          const int first = gid[c[0]] < gid[c[1]] ? (gid[c[0]] < gid[c[2]] ? 0 : 2)
+                                                  : (gid[c[1]] < gid[c[2]] ? 1 : 2);
+          std::rotate(c, c + first, c + 3);
+          double e1[3], e2[3];
+          for (int k = 0; k < 3; ++k)
+          {
+            e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
+            e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
+          }
+          vtkMath::Cross(e1, e2, &this->TriangleCross[3 * t]);
+        }
+      });
+  }
+
   NormalTerm TermOf(vtkIdType t) const
   {
     const std::vector<vtkIdType>& gid = this->Numbering.Gid;
-    const T* x = this->Smoothed.data();
-    vtkIdType c[3] = { static_cast<vtkIdType>(this->Triangles[3 * t]),
-      static_cast<vtkIdType>(this->Triangles[3 * t + 1]),
-      static_cast<vtkIdType>(this->Triangles[3 * t + 2]) };
-    const int first =
-      gid[c[0]] < gid[c[1]] ? (gid[c[0]] < gid[c[2]] ? 0 : 2) : (gid[c[1]] < gid[c[2]] ? 1 : 2);
-    std::rotate(c, c + first, c + 3);
     NormalTerm out;
-    double e1[3], e2[3];
-    for (int k = 0; k < 3; ++k)
-    {
-      e1[k] = static_cast<double>(x[3 * c[1] + k]) - static_cast<double>(x[3 * c[0] + k]);
-      e2[k] = static_cast<double>(x[3 * c[2] + k]) - static_cast<double>(x[3 * c[0] + k]);
-    }
-    vtkMath::Cross(e1, e2, out.Cross);
-    out.Key = { gid[c[0]], gid[c[1]], gid[c[2]] };
+    out.Key = { gid[static_cast<vtkIdType>(this->Triangles[3 * t])],
+      gid[static_cast<vtkIdType>(this->Triangles[3 * t + 1])],
+      gid[static_cast<vtkIdType>(this->Triangles[3 * t + 2])] };
     std::sort(out.Key.begin(), out.Key.end());
+    std::copy_n(&this->TriangleCross[3 * t], 3, out.Cross);
     return out;
   }
 
@@ -1543,6 +1564,7 @@ private:
   std::vector<std::int64_t> Row;
   double CosEdgeAngle = 1.0;
   std::vector<Pending> PendingRemote;
+  std::vector<double> TriangleCross; // per triangle, while the normals are summed
 
   std::vector<std::int64_t> Owned; // the vertices this rank moves, one stencil row each
   rgmc::Stencils Stencil;
