@@ -1600,10 +1600,11 @@ bool MeasureSurface(Ranks& ranks, const PieceRepair<T, I>& repair, const T* posi
   {
     return false;
   }
-  std::int64_t words[8], totals[8];
+  constexpr int n = rgmc::ExactSum::Words;
+  std::int64_t words[2 * n], totals[2 * n];
   sums.TwiceArea.ToWords(words);
-  sums.SixVolume.ToWords(words + 4);
-  ranks.AllReduce(words, totals, 8, vtkCommunicator::SUM_OP, "summing the measures");
+  sums.SixVolume.ToWords(words + n);
+  ranks.AllReduce(words, totals, 2 * n, vtkCommunicator::SUM_OP, "summing the measures");
   const vtkIdType count = static_cast<vtkIdType>(mine.size());
   std::vector<vtkIdType> lengths(ranks.Size), offsets(ranks.Size, 0);
   ranks.AllGather(&count, lengths.data(), 1, "counting the border edges");
@@ -1626,7 +1627,7 @@ bool MeasureSurface(Ranks& ranks, const PieceRepair<T, I>& repair, const T* posi
       }
       const rgmc::Caps caps = rgmc::BorderCaps(std::move(edges), box);
       const double twiceArea = rgmc::ExactSum::FromWordSums(totals).Get();
-      const double sixVolume = rgmc::ExactSum::FromWordSums(totals + 4).Get();
+      const double sixVolume = rgmc::ExactSum::FromWordSums(totals + n).Get();
       measures.Area = 0.5 * twiceArea * scale * scale;
       // Counterclockwise in index space, as marching cubes orders triangles: a mirroring
       // direction turns them clockwise in the world.

@@ -38,38 +38,53 @@ public:
       this->Value +=
         static_cast<unsigned __int128>(static_cast<__int128>(static_cast<std::int64_t>(scaled)));
     }
-    else
+    else if (std::fabs(term) < 0x1p60) // and not NaN
     {
       this->Value += static_cast<unsigned __int128>(static_cast<__int128>(scaled));
     }
+    else
+    {
+      ++this->NotFinite; // a NaN or infinite point: the sum is NaN
+    }
   }
-  void Add(const ExactSum& other) { this->Value += other.Value; }
+  void Add(const ExactSum& other)
+  {
+    this->Value += other.Value;
+    this->NotFinite += other.NotFinite;
+  }
 
-  /// The sum as four 32-bit words, each in an int64 (summed over ranks, they cannot overflow).
-  void ToWords(std::int64_t words[4]) const
+  /// The sum as Words values: four 32-bit words and the count of terms that were not finite,
+  /// each in an int64 (summed over ranks, they cannot overflow).
+  static constexpr int Words = 5;
+  void ToWords(std::int64_t words[Words]) const
   {
     for (int w = 0; w < 4; ++w)
     {
       words[w] = static_cast<std::int64_t>((this->Value >> (32 * w)) & 0xffffffffu);
     }
+    words[4] = this->NotFinite;
   }
   /// The sum of the ranks' sums, from the sums of their words.
-  static ExactSum FromWordSums(const std::int64_t words[4])
+  static ExactSum FromWordSums(const std::int64_t words[Words])
   {
     ExactSum sum;
     for (int w = 0; w < 4; ++w)
     {
       sum.Value += static_cast<unsigned __int128>(words[w]) << (32 * w);
     }
+    sum.NotFinite = words[4];
     return sum;
   }
   double Get() const
   {
-    return std::ldexp(static_cast<double>(static_cast<__int128>(this->Value)), -FractionBits);
+    return this->NotFinite
+      ? std::nan("")
+      : std::ldexp(static_cast<double>(static_cast<__int128>(this->Value)), -FractionBits);
   }
 
 private:
   unsigned __int128 Value = 0;
+  std::int64_t NotFinite = 0;
 };
 
 /// The box of the volume the surface came from: index space [Extent] mapped to the world by

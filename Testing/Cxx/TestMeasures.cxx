@@ -13,7 +13,8 @@
 //   ranks and decompositions as on one rank (and on any number of threads: UpdateAtThreads);
 // - Laplacian smoothing shrinks the volume, windowed sinc less;
 // - a surface with a hole inside the volume has no volume (NaN), and still its area;
-// - without vertex keys (border vertices told by their coordinates) the measures are the same.
+// - without vertex keys (border vertices told by their coordinates) the measures are the same;
+// - a NaN point makes the area and the volume NaN.
 #include "rgmcDistributedData.h"
 #include "rgmcTestController.h"
 #include "rgmcTestData.h"
@@ -450,6 +451,28 @@ void Hole(vtkMultiProcessController* controller)
     "a sphere with a hole on " << ranks << " ranks: " << Text(m));
 }
 
+/// A point that is not a number: no area and no volume (NaN), on every rank, and no undefined
+/// conversion on the way (the sanitizers run this too).
+void NotANumber(vtkMultiProcessController* controller)
+{
+  const Case c = Cases()[0];
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  vtkSmartPointer<vtkImageData> image =
+    MakePiece(Maker(c), Whole, PieceOf("block", Whole, rank, ranks));
+  vtkSmartPointer<vtkPolyData> extracted =
+    Extract(controller, image, 0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}).Output;
+  if (rank == 0 && extracted->GetNumberOfPoints() > 0)
+  {
+    auto broken = vtkSmartPointer<vtkPolyData>::New();
+    broken->DeepCopy(extracted);
+    broken->GetPoints()->SetPoint(0, std::nan(""), 0.0, 0.0);
+    extracted = broken;
+  }
+  const Measured m = Read(Repair(controller, extracted, 0, "a sphere with a NaN point"));
+  RGMC_CHECK(std::isnan(m.Values[0]) && std::isnan(m.Values[1]) && std::isnan(m.Values[3]),
+    "a sphere with a NaN point on " << ranks << " ranks: " << Text(m));
+}
+
 } // namespace
 
 int main(int argc, char* argv[])
@@ -460,5 +483,6 @@ int main(int argc, char* argv[])
     Check(controller, c);
   }
   Hole(controller);
+  NotANumber(controller);
   return Finish(controller, "TestMeasures");
 }
