@@ -1669,7 +1669,7 @@ struct vtkRGSeamRepair::Run
   LocalVertices vertices;
   GlobalNumbering numbering;
   BorderTest border;
-  rgmc::VolumeBox box; // the volume's, or the mesh's bounds when the input does not say
+  rgmc::VolumeBox box;    // the volume's, or the mesh's bounds when the input does not say
   Measures before, after; // before and after smoothing
   bool smooth = false;
   std::vector<vtkIdType> connectivity; // the triangles over the vertices, when merged or copied
@@ -1851,10 +1851,9 @@ void vtkRGSeamRepair::FindBorder(Run& run)
   // Every rank must take the same box, ranks without points included.
   vtkDoubleArray* geometry =
     vtkDoubleArray::SafeDownCast(input->GetFieldData()->GetArray("VolumeGeometry"));
-  const int described = whole && whole->GetNumberOfValues() == 6 && geometry &&
-      geometry->GetNumberOfValues() == 15
-    ? 1
-    : 0;
+  const bool hasBox =
+    whole && whole->GetNumberOfValues() == 6 && geometry && geometry->GetNumberOfValues() == 15;
+  const int described = hasBox ? 1 : 0;
   int allDescribed = 0;
   run.ranks.AllReduce(
     &described, &allDescribed, 1, vtkCommunicator::MIN_OP, "agreeing on the volume's box");

@@ -15,8 +15,8 @@ void VolumeBox::ToIndex(const double world[3], double index[3]) const
   for (int c = 0; c < 3; ++c)
   {
     // Direction is orthonormal: its inverse is its transpose.
-    const double along = this->Direction[c] * d[0] + this->Direction[3 + c] * d[1] +
-      this->Direction[6 + c] * d[2];
+    const double along =
+      this->Direction[c] * d[0] + this->Direction[3 + c] * d[1] + this->Direction[6 + c] * d[2];
     index[c] = along / this->Spacing[c];
   }
 }
@@ -93,8 +93,8 @@ namespace
 /// a parameter t in [0, perimeter).
 struct Face
 {
-  int Bit;      // the face's bit in BorderEdge's face masks
-  int U, V;     // the index axes of the rectangle's coordinates
+  int Bit;  // the face's bit in BorderEdge's face masks
+  int U, V; // the index axes of the rectangle's coordinates
   double U0, U1, V0, V1;
   int SideBits[4]; // the faces along sides v = V0, u = U1, v = V1, u = U0
 
@@ -162,8 +162,8 @@ struct FaceCap
 {
   bool HasEdges = false;
   bool HasEvents = false;
-  double TwiceLoopArea = 0.0;                    // the mesh's edges alone
-  double TwiceArea = 0.0;                        // the cap, when HasEvents
+  double TwiceLoopArea = 0.0;                     // the mesh's edges alone
+  double TwiceArea = 0.0;                         // the cap, when HasEvents
   std::vector<std::pair<double, double>> Covered; // the sides' stretches in the cap (t, t')
 };
 
@@ -172,7 +172,8 @@ bool CoveredAt(const FaceCap& cap, double t, double perimeter)
   for (const auto& stretch : cap.Covered)
   {
     const double end = stretch.second < stretch.first ? stretch.second + perimeter : stretch.second;
-    if ((t >= stretch.first && t <= end) || (t + perimeter >= stretch.first && t + perimeter <= end))
+    if ((t >= stretch.first && t <= end) ||
+      (t + perimeter >= stretch.first && t + perimeter <= end))
     {
       return true;
     }
@@ -193,7 +194,8 @@ Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
   for (std::size_t i = 0; i < edges.size();)
   {
     std::size_t j = i + 1;
-    while (j < edges.size() && std::min(edges[j].From, edges[j].To) == std::min(edges[i].From, edges[i].To) &&
+    while (j < edges.size() &&
+      std::min(edges[j].From, edges[j].To) == std::min(edges[i].From, edges[i].To) &&
       std::max(edges[j].From, edges[j].To) == std::max(edges[i].From, edges[i].To))
     {
       ++j;
@@ -328,8 +330,8 @@ Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
       {
         if (other.SideBits[side] == face.Bit)
         {
-          const double middle = other.SideStart(side) +
-            0.5 * (side % 2 ? other.Height() : other.Width());
+          const double middle =
+            other.SideStart(side) + 0.5 * (side % 2 ? other.Height() : other.Width());
           inside = CoveredAt(faces[g], middle, other.Perimeter()) ? 1 : 0;
         }
       }
@@ -349,8 +351,8 @@ Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
     const Face face(f, box);
     const int axis = f / 2;
     const double area = 0.5 * faces[f].TwiceArea * box.Spacing[face.U] * box.Spacing[face.V];
-    const double distance = 0.5 * (box.Extent[2 * axis + 1] - box.Extent[2 * axis]) *
-      box.Spacing[axis];
+    const double distance =
+      0.5 * (box.Extent[2 * axis + 1] - box.Extent[2 * axis]) * box.Spacing[axis];
     caps.SixVolume += 2.0 * distance * area;
     caps.Area += area;
     ++caps.Faces;

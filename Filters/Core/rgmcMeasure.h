@@ -148,8 +148,8 @@ struct TriangleSums
 /// caps: it is on the mesh's boundary when no other triangle has it), as the triangle runs it.
 struct BorderEdge
 {
-  std::int64_t From, To;     // global point ids
-  int FromFaces, ToFaces;    // faces each end lies on: bits x-, x+, y-, y+, z-, z+
+  std::int64_t From, To;           // global point ids
+  int FromFaces, ToFaces;          // faces each end lies on: bits x-, x+, y-, y+, z-, z+
   double FromIndex[3], ToIndex[3]; // positions in index space
 
   static constexpr int Words = 10; // as doubles, for a gather

@@ -76,10 +76,10 @@ struct Case
   std::string Name;
   std::function<double(int, int, int)> Field; // inside where >= 0
   int Direction;
-  bool HasApex;        // a point on every cutting plane: the oracle's apex
-  double Apex[3];      // in index space
-  double ExactVolume;  // when !HasApex: the exact volume in index units (times the voxel's),
-                       // or 0: the caps by marching squares on the faces (FaceCapsOracle)
+  bool HasApex;       // a point on every cutting plane: the oracle's apex
+  double Apex[3];     // in index space
+  double ExactVolume; // when !HasApex: the exact volume in index units (times the voxel's),
+                      // or 0: the caps by marching squares on the faces (FaceCapsOracle)
 };
 
 std::vector<Case> Cases()
@@ -95,23 +95,23 @@ std::vector<Case> Cases()
     Case{ "sphere cut by face z-", sphere(15.3, 16.2, 0.0, 10.4), 1, true, { 0, 0, 0 }, 0 });
   cases.push_back(
     Case{ "sphere at corner x- y- z-", sphere(0, 0, 0, 13.6), 0, true, { 0, 0, 0 }, 0 });
-  cases.push_back(Case{ "sphere at corner x+ y+ z+ (mirrored direction)",
-    sphere(32, 32, 32, 13.6), 2, true, { 32, 32, 32 }, 0 });
+  cases.push_back(Case{ "sphere at corner x+ y+ z+ (mirrored direction)", sphere(32, 32, 32, 13.6),
+    2, true, { 32, 32, 32 }, 0 });
   cases.push_back(Case{ "box cut by face x+",
     [](int i, int j, int k)
     {
-      return std::min({ 10.0 - std::abs(i - 28.3), 7.2 - std::abs(j - 15.6),
-        9.3 - std::abs(k - 14.1) });
+      return std::min(
+        { 10.0 - std::abs(i - 28.3), 7.2 - std::abs(j - 15.6), 9.3 - std::abs(k - 14.1) });
     },
     1, true, { 32, 0, 0 }, 0 });
   // A slab across the whole volume in x and y: caps on four sides, none meeting at a point.
   // The field is linear along k where it crosses 0: the faces are planes at k = 10.85, 21.35.
-  cases.push_back(Case{ "slab across four sides",
-    [](int, int, int k) { return 5.25 - std::abs(k - 16.1); }, 1, false, { 0, 0, 0 },
-    32.0 * 32.0 * 10.5 });
+  cases.push_back(
+    Case{ "slab across four sides", [](int, int, int k) { return 5.25 - std::abs(k - 16.1); }, 1,
+      false, { 0, 0, 0 }, 32.0 * 32.0 * 10.5 });
   // Everything above k = 10.3: its cap on face z+ has no edge of the mesh on it.
-  cases.push_back(Case{ "half space reaching face z+",
-    [](int, int, int k) { return k - 10.3; }, 2, false, { 0, 0, 0 }, 32.0 * 32.0 * 21.7 });
+  cases.push_back(Case{ "half space reaching face z+", [](int, int, int k) { return k - 10.3; }, 2,
+    false, { 0, 0, 0 }, 32.0 * 32.0 * 21.7 });
   // Many blobs, cut by every face, with caps meeting at the volume's edges and corners.
   for (int seed : { 5, 17 })
   {
@@ -175,8 +175,8 @@ double FaceCapsOracle(const Case& c, double& capArea, double& slack, double& are
           const auto& y = polygon[(p + 1) % polygon.size()];
           twice += x[0] * y[1] - x[1] * y[0];
         }
-        const bool saddle = (f[0] >= 0) == (f[2] >= 0) && (f[1] >= 0) == (f[3] >= 0) &&
-          (f[0] >= 0) != (f[1] >= 0);
+        const bool saddle =
+          (f[0] >= 0) == (f[2] >= 0) && (f[1] >= 0) == (f[3] >= 0) && (f[0] >= 0) != (f[1] >= 0);
         if (saddle)
         {
           saddles += 1.0; // at most the whole cell is in doubt
@@ -394,14 +394,16 @@ void Check(vtkMultiProcessController* controller, const Case& c)
     }
     // Laplacian shrinks a curved surface; windowed sinc much less.
     const double before = reference[0].Values[1];
-    const double laplacian = reference[1].Values[1] - before, sinc = reference[2].Values[1] - before;
+    const double laplacian = reference[1].Values[1] - before,
+                 sinc = reference[2].Values[1] - before;
     RGMC_CHECK(c.Name.find("sphere") == std::string::npos ||
         (laplacian < 0 && std::abs(sinc) < std::abs(laplacian)),
       c.Name << ": volume change " << laplacian << " (Laplacian), " << sinc << " (windowed sinc)");
   }
   for (const std::string& how : Decompositions(ranks))
   {
-    vtkSmartPointer<vtkImageData> image = MakePiece(Maker(c), Whole, PieceOf(how, Whole, rank, ranks));
+    vtkSmartPointer<vtkImageData> image =
+      MakePiece(Maker(c), Whole, PieceOf(how, Whole, rank, ranks));
     vtkSmartPointer<vtkPolyData> extracted =
       Extract(controller, image, 0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}).Output;
     for (int method = 0; method < 3; ++method)
