@@ -160,7 +160,6 @@ struct Event
 
 struct FaceCap
 {
-  bool HasEdges = false;
   bool HasEvents = false;
   double TwiceLoopArea = 0.0;                     // the mesh's edges alone
   double TwiceArea = 0.0;                         // the cap, when HasEvents
@@ -215,14 +214,12 @@ Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
     FaceCap& cap = faces[f];
     // The cap's outline runs the mesh's boundary edges backwards.
     std::map<std::int64_t, std::pair<int, const BorderEdge*>> net; // gid: out - in
-    std::map<std::int64_t, bool> atFrom;
     for (const BorderEdge& e : boundary)
     {
       if (!(e.FromFaces & e.ToFaces & face.Bit))
       {
         continue;
       }
-      cap.HasEdges = true;
       const double p[2] = { e.ToIndex[face.U], e.ToIndex[face.V] };
       const double q[2] = { e.FromIndex[face.U], e.FromIndex[face.V] };
       cap.TwiceLoopArea += face.Cross(p, q);

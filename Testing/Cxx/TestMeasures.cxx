@@ -422,15 +422,20 @@ void Check(vtkMultiProcessController* controller, const Case& c)
   }
 }
 
+/// This rank's piece of the closed sphere (the first case), extracted in blocks.
+vtkSmartPointer<vtkPolyData> ClosedSphere(vtkMultiProcessController* controller)
+{
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  vtkSmartPointer<vtkImageData> image =
+    MakePiece(Maker(Cases()[0]), Whole, PieceOf("block", Whole, rank, ranks));
+  return Extract(controller, image, 0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}).Output;
+}
+
 /// A hole inside the volume: no enclosed volume, the area still reported.
 void Hole(vtkMultiProcessController* controller)
 {
-  const Case c = Cases()[0];
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
-  vtkSmartPointer<vtkImageData> image =
-    MakePiece(Maker(c), Whole, PieceOf("block", Whole, rank, ranks));
-  vtkSmartPointer<vtkPolyData> extracted =
-    Extract(controller, image, 0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}).Output;
+  vtkSmartPointer<vtkPolyData> extracted = ClosedSphere(controller);
   if (rank == 0 && extracted->GetNumberOfPolys() > 0)
   {
     vtkNew<vtkCellArray> fewer;
@@ -457,12 +462,8 @@ void Hole(vtkMultiProcessController* controller)
 /// conversion on the way (the sanitizers run this too).
 void NotANumber(vtkMultiProcessController* controller)
 {
-  const Case c = Cases()[0];
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
-  vtkSmartPointer<vtkImageData> image =
-    MakePiece(Maker(c), Whole, PieceOf("block", Whole, rank, ranks));
-  vtkSmartPointer<vtkPolyData> extracted =
-    Extract(controller, image, 0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}).Output;
+  vtkSmartPointer<vtkPolyData> extracted = ClosedSphere(controller);
   if (rank == 0 && extracted->GetNumberOfPoints() > 0)
   {
     auto broken = vtkSmartPointer<vtkPolyData>::New();
