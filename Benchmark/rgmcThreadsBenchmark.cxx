@@ -4,6 +4,8 @@
 // backend asked for (the one that ran is recorded). Minimum of the repeats; JSON on stdout.
 //
 //   rgmcThreadsBenchmark [--size 512] [--threads 1,2] [--repeats 3] [--backend STDThread]
+//                        [--only repair]
+// --only repair extracts the skull once and times Seam Repair alone (for a profiler: perf record).
 #include "rgmcBenchmark.h"
 #include "rgmcThreadCompare.h" // Difference
 
@@ -39,6 +41,7 @@ int main(int argc, char* argv[])
   int size = 512, repeats = 3;
   std::vector<int> threadCounts = { 1, 2 };
   std::string backend = "STDThread";
+  bool repairOnly = false;
   for (int a = 1; a + 1 < argc; a += 2)
   {
     const std::string arg = argv[a];
@@ -58,10 +61,15 @@ int main(int argc, char* argv[])
     {
       threadCounts = IntList(argv[a + 1]);
     }
+    else if (arg == "--only" && std::string(argv[a + 1]) == "repair")
+    {
+      repairOnly = true;
+    }
     else
     {
       std::cerr
-        << "usage: rgmcThreadsBenchmark [--size N] [--threads 1,2] [--repeats N] [--backend B]\n";
+        << "usage: rgmcThreadsBenchmark [--size N] [--threads 1,2] [--repeats N] [--backend B]\n"
+           "                            [--only repair]\n";
       return 2;
     }
   }
@@ -96,14 +104,14 @@ int main(int argc, char* argv[])
         flying->SetValue(0, 400);
         flying->ComputeNormalsOn();
         flying->ComputeScalarsOff();
-        fe = FastestUpdate(repeats, flying.Get());
+        fe = repairOnly ? 0.0 : FastestUpdate(repeats, flying.Get());
         feTriangles = flying->GetOutput()->GetNumberOfCells();
 
         vtkNew<vtkRGMarchingCubes> rg;
         rg->SetInputData(image);
         rg->SetIsovalue(400);
         rg->AddSeedPoint(0, 0, 105);
-        seeded = FastestUpdate(repeats, rg.Get());
+        seeded = FastestUpdate(repairOnly ? 1 : repeats, rg.Get());
         seededTriangles = rg->GetOutput()->GetNumberOfCells();
         auto seededOut = vtkSmartPointer<vtkPolyData>::New();
         seededOut->DeepCopy(rg->GetOutput());
@@ -118,7 +126,7 @@ int main(int argc, char* argv[])
         repaired->DeepCopy(repairFilter->GetOutput());
 
         rg->SetExtractionMode(vtkRGMarchingCubes::ALL_COMPONENTS);
-        all = FastestUpdate(repeats, rg.Get());
+        all = repairOnly ? 0.0 : FastestUpdate(repeats, rg.Get());
         allTriangles = rg->GetOutput()->GetNumberOfCells();
         auto allOut = vtkSmartPointer<vtkPolyData>::New();
         allOut->DeepCopy(rg->GetOutput());
