@@ -9,12 +9,74 @@
 #include <sys/mman.h>
 #define RGMC_HAVE_MMAP 1
 #endif
+#include <cstdint>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <type_traits>
+#include <vector>
 
 namespace rgmc
 {
+
+/// Asks the operating system to back the 2 MiB-aligned part of [data, data + bytes) with huge
+/// pages where it can (Linux's transparent huge pages, which Debian's kernels give on request):
+/// a large array is then paged in 2 MiB at a time, one page fault where there would be 512.
+/// Only a hint; nothing else changes. Below 4 MiB it does nothing.
+inline void AdviseHugePages(void* data, std::size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t huge = std::uintptr_t(1) << 21;
+  if (!data || bytes < 2 * huge)
+  {
+    return;
+  }
+  const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t begin = (at + huge - 1) & ~(huge - 1);
+  const std::uintptr_t end = (at + bytes) & ~(huge - 1);
+  if (end > begin)
+  {
+    madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+  }
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
+/// std::allocator for arrays that may be large (the surface's nodes): the same memory, with
+/// huge pages asked for (AdviseHugePages).
+template <typename T>
+struct LargeArrayAllocator
+{
+  using value_type = T;
+  LargeArrayAllocator() = default;
+  template <typename U>
+  LargeArrayAllocator(const LargeArrayAllocator<U>&) noexcept
+  {
+  }
+  T* allocate(std::size_t n)
+  {
+    T* data = std::allocator<T>().allocate(n);
+    AdviseHugePages(data, n * sizeof(T));
+    return data;
+  }
+  void deallocate(T* data, std::size_t n) noexcept { std::allocator<T>().deallocate(data, n); }
+  template <typename U>
+  bool operator==(const LargeArrayAllocator<U>&) const noexcept
+  {
+    return true;
+  }
+  template <typename U>
+  bool operator!=(const LargeArrayAllocator<U>&) const noexcept
+  {
+    return false;
+  }
+};
+
+/// A std::vector that may be large (LargeArrayAllocator).
+template <typename T>
+using LargeVector = std::vector<T, LargeArrayAllocator<T>>;
 
 template <typename T>
 class Buffer
@@ -70,6 +132,7 @@ public:
       }
       this->Data = grown;
       this->Capacity = capacity;
+      AdviseHugePages(grown, capacity * sizeof(T));
     }
   }
 

@@ -10,6 +10,7 @@
 #ifndef rgmcCubeSurface_h
 #define rgmcCubeSurface_h
 
+#include "rgmcBuffer.h"
 #include "rgmcCaseTable.h"
 #include "rgmcGrid.h"
 #include "rgmcUnionFind.h"
@@ -81,6 +82,9 @@ struct SurfaceNode
   std::uint8_t Node;
   bool Degenerate;
 };
+
+/// The nodes growth found (a few per cube of the surface: a large array).
+using NodeList = LargeVector<SurfaceNode>;
 
 /// The cube edge that runs along `axis` with its lower corner offset by du, dv (0 or 1) along
 /// the two other axes (in increasing axis order), from the corner and edge conventions.
