@@ -2,9 +2,11 @@
 // the same on any number of ranks.
 #include "vtkRGSeamRepair.h"
 
+#include "rgmcBuffer.h"
 #include "rgmcGrid.h"
 #include "rgmcKeyMap.h"
 #include "rgmcMeasure.h"
+#include "rgmcRadixSort.h"
 #include "rgmcSmoothing.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
@@ -40,9 +42,11 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <numeric>
 #include <queue>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
@@ -130,7 +134,17 @@ LocalVertices MergeLocal(
     }
     all[p].second = p;
   }
-  rgmc::ParallelSort(all); // (identity, point) pairs are distinct
+  // (identity, point) pairs are distinct. One-word identities (the keys) by a radix sort: the
+  // points come in increasing order, so its stable order is the pairs' order.
+  if constexpr (Words == 1)
+  {
+    rgmc::RadixSort(
+      all, [](const std::pair<Identity<Words>, vtkIdType>& entry) { return entry.first[0]; });
+  }
+  else
+  {
+    rgmc::ParallelSort(all);
+  }
   LocalVertices local;
   bool duplicates = false;
   for (std::size_t i = 1; i < all.size() && !duplicates; ++i)
@@ -639,9 +653,9 @@ public:
       return false;
     }
     // The stencils are done with: the normals need the memory.
-    std::vector<std::int64_t>().swap(this->Stencil.Neighbours);
+    std::vector<I>().swap(this->Stencil.Neighbours);
     std::vector<std::int64_t>().swap(this->Stencil.Offsets);
-    std::vector<std::int64_t>().swap(this->Owned);
+    std::vector<I>().swap(this->Owned);
     if (!this->AllRanks.Agree(true, problem) || aborted)
     {
       return false;
@@ -662,7 +676,10 @@ public:
           [&]()
           {
             sums.assign(3 * this->NumVertices, 0.0);
-            this->CornersAround(this->CornerOffsets, this->Corners);
+            if (this->CornerOffsets.empty())
+            {
+              this->CornersAround(this->CornerOffsets, this->Corners);
+            }
             this->ComputeTriangleCrosses();
             this->ListSharedTerms(toOwners);
           }))
@@ -680,7 +697,7 @@ public:
     {
       return {};
     }
-    std::vector<double>().swap(this->TriangleCross);
+    rgmc::LargeVector<double>().swap(this->TriangleCross);
     this->Update(sums.data(), NormalBackTag);
     if (!this->AllRanks.Step(
           "compute normals", problem, [&]() { normals.assign(sums.begin(), sums.end()); }))
@@ -814,7 +831,8 @@ private:
   }
 
   /// Every vertex this rank owns, in gid order: its whole neighbourhood, its edges in the
-  /// checks, its stencil row. Then the corner lists are released.
+  /// checks, its stencil row. Then the corner lists are released, unless the normals
+  /// will need them (`stencils`: the surface is smoothed).
   void AssembleNeighbourhoods(
     const std::vector<std::vector<vtkIdType>>& received, bool stencils, Checks& checks)
   {
@@ -835,8 +853,11 @@ private:
         this->AddVertex(this->Numbering.SharedVertex[i], i, &edges, stencils, checks);
       }
     }
-    std::vector<vtkIdType>().swap(this->Corners);
-    std::vector<vtkIdType>().swap(this->CornerOffsets);
+    if (!stencils)
+    {
+      std::vector<I>().swap(this->Corners);
+      std::vector<vtkIdType>().swap(this->CornerOffsets);
+    }
   }
 
   /// Vertices no other rank holds, in memory order: most are inside a closed manifold piece of
@@ -870,7 +891,7 @@ private:
     {
       std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex AddVertex takes
       std::vector<vtkIdType> Ends;     // row ends in Neighbours, per manifold vertex
-      std::vector<std::int64_t> Neighbours;
+      std::vector<I> Neighbours;
       vtkIdType Edges = 0;
     };
     // Batches of blocks bound the rows held apart (memory), whatever the mesh's size.
@@ -934,7 +955,7 @@ private:
   /// counted in `edges` and its row appended to `row` (when stencils are made). Reads only:
   /// threads may call it at once, each with its own `ends`.
   bool ManifoldRow(vtkIdType v, bool stencils, std::vector<std::pair<vtkIdType, vtkIdType>>& ends,
-    std::vector<std::int64_t>& row, vtkIdType& edges) const
+    std::vector<I>& row, vtkIdType& edges) const
   {
     this->EndsAt(v, ends);
     bool manifold = !ends.empty() && ends.size() < 2 * 255;
@@ -952,7 +973,7 @@ private:
       edges += ends[e].first > this->Numbering.Gid[v];
       if (stencils)
       {
-        row.push_back(ends[e].second);
+        row.push_back(static_cast<I>(ends[e].second));
       }
     }
     return true;
@@ -1082,17 +1103,22 @@ private:
         return rgmc::ExceedsEdgeAngle(pa, this->Positions + 3 * v, pb, this->CosEdgeAngle);
       },
       this->Row);
-    this->Owned.push_back(v);
+    this->Owned.push_back(static_cast<I>(v));
     for (std::int64_t g : this->Row)
     {
       const Neighbour& nb = find(g);
       if (nb.Local >= 0)
       {
-        this->Stencil.Neighbours.push_back(nb.Local);
+        this->Stencil.Neighbours.push_back(static_cast<I>(nb.Local));
         continue;
       }
+      if (this->PendingRemote.size() >= static_cast<std::size_t>(std::numeric_limits<I>::max()))
+      {
+        throw std::length_error("more neighbours held elsewhere than 32-bit indices can number "
+                                "in one piece");
+      }
       this->Stencil.Neighbours.push_back(
-        -1 - static_cast<std::int64_t>(this->PendingRemote.size()));
+        static_cast<I>(-1 - static_cast<std::int64_t>(this->PendingRemote.size())));
       this->PendingRemote.push_back(Pending{ nb.Gid, nb.Provider, { nb.X[0], nb.X[1], nb.X[2] } });
     }
     this->Stencil.Offsets.push_back(static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
@@ -1101,7 +1127,7 @@ private:
   /// Ends the stencil row of vertex v, whose neighbours are appended.
   void CloseRow(vtkIdType v)
   {
-    this->Owned.push_back(v);
+    this->Owned.push_back(static_cast<I>(v));
     this->Stencil.Offsets.push_back(static_cast<std::int64_t>(this->Stencil.Neighbours.size()));
   }
 
@@ -1124,9 +1150,16 @@ private:
       }
       slotOf[o] = static_cast<vtkIdType>(this->RemoteGids.size()) - 1;
     }
-    for (std::int64_t& s : this->Stencil.Neighbours)
+    // The slots are indices of type I, as the vertices are.
+    if (this->NumVertices + static_cast<vtkIdType>(this->RemoteGids.size()) >
+      static_cast<vtkIdType>(std::numeric_limits<I>::max()))
     {
-      s = s < 0 ? this->NumVertices + slotOf[-1 - s] : s;
+      throw std::length_error("more vertices and neighbours held elsewhere than 32-bit indices "
+                              "can number in one piece");
+    }
+    for (I& s : this->Stencil.Neighbours)
+    {
+      s = s < 0 ? static_cast<I>(this->NumVertices + slotOf[-1 - static_cast<vtkIdType>(s)]) : s;
     }
     std::vector<Pending>().swap(this->PendingRemote);
   }
@@ -1368,17 +1401,56 @@ private:
     }
   }
 
-  /// Each vertex's own terms, on threads (each range with its own list of terms).
+  /// A triangle at a vertex, by the global ids of its two other corners (sorted) and its index.
+  /// Triangles that share the vertex compare by these pairs exactly as their NormalTerms compare
+  /// by all three sorted ids (putting one common value into sorted pairs keeps their order,
+  /// ties included), so sorting them with the same std::sort, from the same corner order, gives
+  /// the terms' order without building the terms.
+  struct TriangleAtVertex
+  {
+    vtkIdType A, B;
+    vtkIdType Triangle;
+    bool operator<(const TriangleAtVertex& o) const
+    {
+      return this->A < o.A || (this->A == o.A && this->B < o.B);
+    }
+  };
+
+  /// Each vertex's sum of this rank's terms, on threads (each range with its own list), in
+  /// SumTerms' order, from TriangleAtVertex. Owned shared vertices are summed again with every
+  /// holder's terms (SumSharedTerms); the other shared ones get their owner's.
   void SumOwnTerms(std::vector<double>& sums) const
   {
+    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
     rgmc::ParallelFor(this->NumVertices, RowGrain,
       [&](vtkIdType first, vtkIdType last)
       {
-        std::vector<NormalTerm> own;
+        std::vector<TriangleAtVertex> around;
         for (vtkIdType v = first; v < last; ++v)
         {
-          this->LocalTerms(v, own);
-          SumTerms(own, &sums[3 * v]);
+          around.clear();
+          for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
+          {
+            const vtkIdType t = this->Corners[c] / 3, k = this->Corners[c] % 3;
+            vtkIdType a = gid[static_cast<vtkIdType>(this->Triangles[3 * t + (k + 1) % 3])];
+            vtkIdType b = gid[static_cast<vtkIdType>(this->Triangles[3 * t + (k + 2) % 3])];
+            if (b < a)
+            {
+              std::swap(a, b);
+            }
+            around.push_back(TriangleAtVertex{ a, b, t });
+          }
+          std::sort(around.begin(), around.end());
+          double* n = &sums[3 * v];
+          n[0] = n[1] = n[2] = 0;
+          for (const TriangleAtVertex& at : around)
+          {
+            for (int k = 0; k < 3; ++k)
+            {
+              n[k] += this->TriangleCross[3 * at.Triangle + k];
+            }
+          }
+          vtkMath::Normalize(n);
         }
       });
   }
@@ -1428,8 +1500,9 @@ private:
 
   // -- helpers -----------------------------------------------------------------------------
 
-  /// The triangle corners (3 t + k) at each vertex, in compressed rows.
-  void CornersAround(std::vector<vtkIdType>& offsets, std::vector<vtkIdType>& corners) const
+  /// The triangle corners (3 t + k, of type I as the connectivity's entries are) at each vertex,
+  /// in compressed rows.
+  void CornersAround(std::vector<vtkIdType>& offsets, std::vector<I>& corners) const
   {
     offsets.assign(static_cast<std::size_t>(this->NumVertices) + 1, 0);
     for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
@@ -1444,7 +1517,7 @@ private:
     std::vector<vtkIdType> fill(offsets.begin(), offsets.end() - 1);
     for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
     {
-      corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = c;
+      corners[fill[static_cast<vtkIdType>(this->Triangles[c])]++] = static_cast<I>(c);
     }
   }
 
@@ -1555,8 +1628,10 @@ private:
   const vtkIdType NumVertices;
   std::vector<bool> Partners; // the ranks that share a vertex with this one
 
-  // The triangle corners at each vertex (while the seams are analysed, and for the normals).
-  std::vector<vtkIdType> CornerOffsets, Corners;
+  // The triangle corners at each vertex: made for the seams' analysis, kept for the normals
+  // when the surface is smoothed.
+  std::vector<vtkIdType> CornerOffsets;
+  std::vector<I> Corners;
   // One vertex's neighbourhood while it is analysed (on the calling thread).
   std::vector<std::pair<vtkIdType, vtkIdType>> Ends;
   std::vector<Neighbour> Around;
@@ -1564,10 +1639,10 @@ private:
   std::vector<std::int64_t> Row;
   double CosEdgeAngle = 1.0;
   std::vector<Pending> PendingRemote;
-  std::vector<double> TriangleCross; // per triangle, while the normals are summed
+  rgmc::LargeVector<double> TriangleCross; // per triangle, while the normals are summed
 
-  std::vector<std::int64_t> Owned; // the vertices this rank moves, one stencil row each
-  rgmc::Stencils Stencil;
+  std::vector<I> Owned; // the vertices this rank moves, one stencil row each
+  rgmc::Stencils<I> Stencil;
   std::vector<vtkIdType> RemoteGids; // neighbours of owned vertices held elsewhere, by slot
   std::vector<int> RemoteProviders;
   std::vector<double> RemoteInitial;
@@ -1721,12 +1796,14 @@ int vtkRGSeamRepair::RequestData(
     return 0;
   }
   this->UpdateProgress(0.05);
+  this->UpdateProgress(0.05);
   // PASS 1: this rank's distinct vertices and their global numbering.
   if (!this->NumberVertices(run))
   {
     vtkErrorMacro(<< "Cannot repair the seams: " << run.problem << ".");
     return 0;
   }
+  this->UpdateProgress(0.25);
   this->UpdateProgress(0.25);
   // PASS 2: how to tell edges on the volume's border.
   this->FindBorder(run);
@@ -1748,6 +1825,7 @@ int vtkRGSeamRepair::RequestData(
     output->Initialize();
     return 0;
   }
+  this->ReportChecks(run, output);
   this->ReportChecks(run, output);
   this->UpdateProgress(1.0);
   return 1;
@@ -1915,6 +1993,7 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
   {
     return false;
   }
+  run.after = run.before;
   run.after = run.before;
   this->UpdateProgress(0.4);
   if (run.smooth)

@@ -123,13 +123,15 @@ enum class SincWindow
 std::vector<double> SincCoefficients(int iterations, double passBand, SincWindow window);
 
 /// Smoothing stencils of many vertices, in compressed rows: the neighbours of vertex row r are
-/// Neighbours[Offsets[r] .. Offsets[r + 1]), indices into the point arrays.
+/// Neighbours[Offsets[r] .. Offsets[r + 1]), indices into the point arrays, of type Index (32
+/// bits where the points' count allows: the smoothing steps read every row each iteration).
+template <typename Index = std::int64_t>
 struct Stencils
 {
   std::vector<std::int64_t> Offsets{ 0 };
-  std::vector<std::int64_t> Neighbours;
+  std::vector<Index> Neighbours;
 
-  void Add(const std::vector<std::int64_t>& neighbours)
+  void Add(const std::vector<Index>& neighbours)
   {
     this->Neighbours.insert(this->Neighbours.end(), neighbours.begin(), neighbours.end());
     this->Offsets.push_back(static_cast<std::int64_t>(this->Neighbours.size()));
@@ -142,8 +144,8 @@ struct Stencils
 /// One Jacobi Laplacian step for the vertices `points[r]` with stencil row r:
 /// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T
 /// (Seam Repair iterates in double and rounds to the points' type once, at the end).
-template <typename T>
-void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* cur,
+template <typename T, typename Index>
+void LaplacianStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* cur,
   T* next, double relaxation, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
   for (std::size_t r = first; r < std::min(last, points.size()); ++r)
@@ -158,7 +160,7 @@ void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& po
     double delta[3] = { 0.0, 0.0, 0.0 };
     for (std::int64_t s = begin; s < end; ++s)
     {
-      const T* w = cur + 3 * stencils.Neighbours[s];
+      const T* w = cur + 3 * static_cast<std::int64_t>(stencils.Neighbours[s]);
       for (int k = 0; k < 3; ++k)
       {
         delta[k] += static_cast<double>(w[k]) - x[k];
@@ -177,8 +179,9 @@ void LaplacianStep(const Stencils& stencils, const std::vector<std::int64_t>& po
 
 /// sum((x[v] - x[w]) / n) over the n neighbours w of vertex v (stencil row r), each difference
 /// rounded to T first, as VTK's windowed sinc does.
-template <typename T>
-void SincDelta(const Stencils& stencils, std::size_t r, std::int64_t v, const T* x, double delta[3])
+template <typename T, typename Index>
+void SincDelta(
+  const Stencils<Index>& stencils, std::size_t r, std::int64_t v, const T* x, double delta[3])
 {
   const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
   const double n = static_cast<double>(end - begin);
@@ -195,8 +198,8 @@ void SincDelta(const Stencils& stencils, std::size_t r, std::int64_t v, const T*
 
 /// The first windowed-sinc step (Taubin): x1 = x0 - 0.5 * sum((x0 - y0) / n),
 /// x3 = c0 x0 + c1 x1 (x1 before it is stored).
-template <typename T>
-void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* x0,
+template <typename T, typename Index>
+void SincFirstStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* x0,
   T* x1, T* x3, const double* c, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
   for (std::size_t r = first; r < std::min(last, points.size()); ++r)
@@ -216,8 +219,8 @@ void SincFirstStep(const Stencils& stencils, const std::vector<std::int64_t>& po
 
 /// A later windowed-sinc step: x2 = x1 - x0 + x1 - sum((x1 - y1) / n), x3 += c x2 (x2 before it
 /// is stored).
-template <typename T>
-void SincStep(const Stencils& stencils, const std::vector<std::int64_t>& points, const T* x0,
+template <typename T, typename Index>
+void SincStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* x0,
   const T* x1, T* x2, T* x3, double c, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
   for (std::size_t r = first; r < std::min(last, points.size()); ++r)

@@ -1,0 +1,76 @@
+// Unit test of rgmc::RadixSort against std::sort: (key, index) records come out as std::sort on
+// the pairs gives them, for keys that differ in few or many bytes, with many equal keys, and for
+// keys whose top bits are set (unsigned order).
+#include "rgmcCheck.h"
+#include "rgmcRadixSort.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <utility>
+#include <vector>
+
+namespace
+{
+
+using Record = std::pair<std::uint64_t, std::int64_t>;
+
+void Check(const std::vector<std::uint64_t>& keys, const char* what)
+{
+  std::vector<Record> sorted(keys.size()), expected(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i)
+  {
+    sorted[i] = expected[i] = Record(keys[i], static_cast<std::int64_t>(i));
+  }
+  std::sort(expected.begin(), expected.end());
+  rgmc::RadixSort(sorted, [](const Record& r) { return r.first; });
+  RGMC_CHECK(sorted == expected, what << ": " << keys.size() << " keys");
+}
+
+} // namespace
+
+int main()
+{
+  std::mt19937_64 random(20261125);
+  Check({}, "empty");
+  Check({ 7 }, "one key");
+  Check({ 5, 5, 5, 5 }, "all equal");
+  for (std::size_t n : { 2, 3, 255, 256, 257, 10000, 300000 })
+  {
+    std::vector<std::uint64_t> keys(n);
+    // Vertex-key-like: 30 significant bits, the upper bytes the same.
+    for (auto& k : keys)
+    {
+      k = random() & ((std::uint64_t(1) << 30) - 1);
+    }
+    Check(keys, "30-bit keys");
+    // Full 64-bit keys, the top bit set in half of them.
+    for (auto& k : keys)
+    {
+      k = random();
+    }
+    Check(keys, "64-bit keys");
+    // Many repeats (few distinct keys), spread over high and low bytes.
+    for (auto& k : keys)
+    {
+      k = (random() % 7) << 56 | (random() % 3);
+    }
+    Check(keys, "repeated keys");
+    // Already sorted and reversed.
+    std::sort(keys.begin(), keys.end());
+    Check(keys, "sorted keys");
+    std::reverse(keys.begin(), keys.end());
+    Check(keys, "reversed keys");
+  }
+  // Keys equal in every byte but one, in each position.
+  for (int b = 0; b < 8; ++b)
+  {
+    std::vector<std::uint64_t> keys(1000);
+    for (auto& k : keys)
+    {
+      k = 0x0123456789abcdefULL ^ ((random() & 0xff) << (8 * b));
+    }
+    Check(keys, "one varying byte");
+  }
+  return 0;
+}
