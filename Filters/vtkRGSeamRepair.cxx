@@ -719,8 +719,11 @@ public:
       {
         for (vtkIdType b = first; b < last; ++b)
         {
-          partial[b].Add(positions, this->Triangles, b * grain,
+          // Summed here, then stored: neighbouring blocks' sums share cache lines.
+          rgmc::TriangleSums sum;
+          sum.Add(positions, this->Triangles, b * grain,
             std::min(this->NumTriangles, (b + 1) * grain), centre, scale);
+          partial[b] = sum;
         }
       });
     rgmc::TriangleSums sums;
@@ -907,7 +910,9 @@ private:
           std::vector<std::pair<vtkIdType, vtkIdType>> blockEnds;
           for (vtkIdType b = first; b < last; ++b)
           {
-            Block& block = blocks[b];
+            // Filled here and moved into place at the end: neighbouring blocks, on other
+            // threads, share cache lines in `blocks`.
+            Block block;
             const vtkIdType start = (batch + b) * blockSize;
             for (vtkIdType v = start; v < std::min(this->NumVertices, start + blockSize); ++v)
             {
@@ -923,6 +928,7 @@ private:
                 block.Ends.push_back(static_cast<vtkIdType>(block.Neighbours.size()));
               }
             }
+            blocks[b] = std::move(block);
           }
         });
       for (Block& block : blocks)

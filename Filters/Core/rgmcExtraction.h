@@ -246,8 +246,9 @@ private:
     int Component;
   };
 
-  /// What one chunk of slabs produced, with chunk-local vertex ids.
-  struct Chunk
+  /// What one chunk of slabs produced, with chunk-local vertex ids. Each on cache lines of its
+  /// own: threads extract neighbouring chunks at once.
+  struct alignas(64) Chunk
   {
     LocalMesh Mesh;
     std::vector<ChunkPort> Ports;

@@ -253,8 +253,9 @@ private:
 
   /// A tile's search state: nodes found in the current round (the queue), crossings received
   /// for the next round and sent to other tiles in this one, and which nodes of its cubes of
-  /// several nodes were found.
-  struct TileWork
+  /// several nodes were found. Each on cache lines of its own: threads grow neighbouring tiles
+  /// at once.
+  struct alignas(64) TileWork
   {
     std::vector<SurfaceNode> Queue;
     std::vector<Crossing> Inbox;
