@@ -56,8 +56,8 @@ void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
 /// Sorts [begin, end) on threads: fixed slices (not one per thread) sorted at once, then merged
 /// pairwise in rounds. The elements must be totally ordered (no two equal), so that the result
 /// is the one std::sort gives, whatever the threads. Needs a buffer of the range's size.
-template <typename T>
-void ParallelSort(std::vector<T>& values)
+template <typename Vector>
+void ParallelSort(Vector& values)
 {
   const std::size_t n = values.size();
   const std::size_t slice = std::max<std::size_t>(4096, (n + 63) / 64);
@@ -77,9 +77,9 @@ void ParallelSort(std::vector<T>& values)
         std::sort(values.begin() + a, values.begin() + std::min(n, a + slice));
       }
     });
-  std::vector<T> buffer(n);
-  std::vector<T>* from = &values;
-  std::vector<T>* to = &buffer;
+  Vector buffer(n);
+  Vector* from = &values;
+  Vector* to = &buffer;
   for (std::size_t run = slice; run < n; run *= 2)
   {
     const vtkIdType pairs = static_cast<vtkIdType>((n + 2 * run - 1) / (2 * run));

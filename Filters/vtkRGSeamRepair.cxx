@@ -35,6 +35,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkTypeInt32Array.h"
+#include "vtkTypeInt64Array.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
@@ -115,7 +116,7 @@ LocalVertices MergeLocal(
   vtkPolyData* input, const vtkIdType* keys, std::vector<Identity<Words>>& ids)
 {
   const vtkIdType n = input->GetNumberOfPoints();
-  std::vector<std::pair<Identity<Words>, vtkIdType>> all(static_cast<std::size_t>(n));
+  rgmc::LargeVector<std::pair<Identity<Words>, vtkIdType>> all(static_cast<std::size_t>(n));
   for (vtkIdType p = 0; p < n; ++p)
   {
     Identity<Words>& id = all[p].first;
@@ -653,7 +654,7 @@ public:
       return false;
     }
     // The stencils are done with: the normals need the memory.
-    std::vector<I>().swap(this->Stencil.Neighbours);
+    rgmc::LargeVector<I>().swap(this->Stencil.Neighbours);
     std::vector<std::int64_t>().swap(this->Stencil.Offsets);
     std::vector<I>().swap(this->Owned);
     if (!this->AllRanks.Agree(true, problem) || aborted)
@@ -670,7 +671,7 @@ public:
   /// three agreements; empty on failure.
   std::vector<float> Normals(std::string& problem)
   {
-    std::vector<double> sums;
+    rgmc::LargeVector<double> sums;
     std::vector<std::vector<vtkIdType>> toOwners(this->AllRanks.Size);
     if (!this->AllRanks.Step("compute normals", problem,
           [&]()
@@ -858,7 +859,7 @@ private:
     }
     if (!stencils)
     {
-      std::vector<I>().swap(this->Corners);
+      rgmc::LargeVector<I>().swap(this->Corners);
       std::vector<vtkIdType>().swap(this->CornerOffsets);
     }
   }
@@ -894,7 +895,7 @@ private:
     {
       std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex AddVertex takes
       std::vector<vtkIdType> Ends;     // row ends in Neighbours, per manifold vertex
-      std::vector<I> Neighbours;
+      rgmc::LargeVector<I> Neighbours;
       vtkIdType Edges = 0;
     };
     // Batches of blocks bound the rows held apart (memory), whatever the mesh's size.
@@ -961,7 +962,7 @@ private:
   /// counted in `edges` and its row appended to `row` (when stencils are made). Reads only:
   /// threads may call it at once, each with its own `ends`.
   bool ManifoldRow(vtkIdType v, bool stencils, std::vector<std::pair<vtkIdType, vtkIdType>>& ends,
-    std::vector<I>& row, vtkIdType& edges) const
+    rgmc::LargeVector<I>& row, vtkIdType& edges) const
   {
     this->EndsAt(v, ends);
     bool manifold = !ends.empty() && ends.size() < 2 * 255;
@@ -1218,7 +1219,7 @@ private:
     const std::function<bool(double)>& progress, bool& aborted, std::string& problem)
   {
     const std::size_t size = 3 * (this->NumVertices + this->RemoteGids.size());
-    std::vector<double> current, next;
+    rgmc::LargeVector<double> current, next;
     if (!this->AllRanks.Step("smooth the surface", problem,
           [&]()
           {
@@ -1248,7 +1249,7 @@ private:
       this->Update(next.data());
       std::swap(current, next);
     }
-    std::vector<double>().swap(next);
+    rgmc::LargeVector<double>().swap(next);
     return this->AllRanks.Step("smooth the surface", problem,
       [&]() { this->Smoothed.assign(current.begin(), current.begin() + 3 * this->NumVertices); });
   }
@@ -1425,7 +1426,7 @@ private:
   /// Each vertex's sum of this rank's terms, on threads (each range with its own list), in
   /// SumTerms' order, from TriangleAtVertex. Owned shared vertices are summed again with every
   /// holder's terms (SumSharedTerms); the other shared ones get their owner's.
-  void SumOwnTerms(std::vector<double>& sums) const
+  void SumOwnTerms(rgmc::LargeVector<double>& sums) const
   {
     const std::vector<vtkIdType>& gid = this->Numbering.Gid;
     rgmc::ParallelFor(this->NumVertices, RowGrain,
@@ -1463,7 +1464,7 @@ private:
 
   /// Owned shared vertices: their own terms and every holder's, in the same order.
   void SumSharedTerms(
-    const std::vector<std::vector<vtkIdType>>& received, std::vector<double>& sums) const
+    const std::vector<std::vector<vtkIdType>>& received, rgmc::LargeVector<double>& sums) const
   {
     const std::vector<vtkIdType>& gid = this->Numbering.Gid;
     std::vector<std::size_t> cursor(this->AllRanks.Size, 0);
@@ -1508,7 +1509,7 @@ private:
 
   /// The triangle corners (3 t + k, of type I as the connectivity's entries are) at each vertex,
   /// in compressed rows.
-  void CornersAround(std::vector<vtkIdType>& offsets, std::vector<I>& corners) const
+  void CornersAround(std::vector<vtkIdType>& offsets, rgmc::LargeVector<I>& corners) const
   {
     offsets.assign(static_cast<std::size_t>(this->NumVertices) + 1, 0);
     for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
@@ -1637,7 +1638,7 @@ private:
   // The triangle corners at each vertex: made for the seams' analysis, kept for the normals
   // when the surface is smoothed.
   std::vector<vtkIdType> CornerOffsets;
-  std::vector<I> Corners;
+  rgmc::LargeVector<I> Corners;
   // One vertex's neighbourhood while it is analysed (on the calling thread).
   std::vector<std::pair<vtkIdType, vtkIdType>> Ends;
   std::vector<Neighbour> Around;
@@ -1838,20 +1839,51 @@ int vtkRGSeamRepair::RequestData(
 }
 
 //------------------------------------------------------------------------------
+namespace
+{
+
+/// How many cells of `polys` do not have 3 points: from the offsets, read straight when they are
+/// 32- or 64-bit arrays (as VTK's cell arrays keep them), else cell by cell.
+vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
+{
+  const vtkIdType cells = polys->GetNumberOfCells();
+  auto count = [cells](const auto* offsets)
+  {
+    vtkIdType other = 0;
+    for (vtkIdType c = 0; c < cells; ++c)
+    {
+      other += offsets[c + 1] - offsets[c] != 3;
+    }
+    return other;
+  };
+  vtkDataArray* offsets = polys->GetOffsetsArray();
+  if (auto* o32 = vtkTypeInt32Array::FastDownCast(offsets))
+  {
+    return count(o32->GetPointer(0));
+  }
+  if (auto* o64 = vtkTypeInt64Array::FastDownCast(offsets))
+  {
+    return count(o64->GetPointer(0));
+  }
+  vtkIdType other = 0;
+  for (vtkIdType c = 0; c < cells; ++c)
+  {
+    other += polys->GetCellSize(c) != 3;
+  }
+  return other;
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
 bool vtkRGSeamRepair::CheckInput(Run& run)
 {
   Ranks& ranks = run.ranks;
   vtkPolyData* input = run.input;
   const vtkIdType verts = input->GetNumberOfVerts(), lines = input->GetNumberOfLines(),
                   strips = input->GetNumberOfStrips();
-  vtkIdType other = 0;
   vtkCellArray* polys = input->GetPolys();
-  vtkIdType npts;
-  const vtkIdType* pts;
-  for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
-  {
-    other += npts != 3;
-  }
+  const vtkIdType other = PolygonsNotTriangles(polys);
   if (verts || lines || strips || other)
   {
     std::ostringstream msg;

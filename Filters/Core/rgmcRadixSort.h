@@ -11,13 +11,14 @@
 namespace rgmc
 {
 
-/// Sorts `values` by `keyOf(value)` (a std::uint64_t, compared as unsigned), least significant
-/// byte first, skipping the bytes in which all keys agree. Stable: values with equal keys keep
-/// their order. So records (key, index) whose indices increase in the input come out exactly as
-/// std::sort on (key, index) gives them.
-template <typename T, typename KeyOf>
-void RadixSort(std::vector<T>& values, KeyOf&& keyOf)
+/// Sorts `values` (a std::vector, with any allocator) by `keyOf(value)` (a std::uint64_t, compared
+/// as unsigned), least significant byte first, skipping the bytes in which all keys agree. Stable:
+/// values with equal keys keep their order. So records (key, index) whose indices increase in the
+/// input come out exactly as std::sort on (key, index) gives them.
+template <typename Vector, typename KeyOf>
+void RadixSort(Vector& values, KeyOf&& keyOf)
 {
+  using T = typename Vector::value_type;
   const std::size_t n = values.size();
   if (n < 2)
   {
@@ -37,9 +38,9 @@ void RadixSort(std::vector<T>& values, KeyOf&& keyOf)
       ++counts[b][(key >> (8 * b)) & 0xff];
     }
   }
-  std::vector<T> buffer(n);
-  std::vector<T>* from = &values;
-  std::vector<T>* to = &buffer;
+  Vector buffer(n);
+  Vector* from = &values;
+  Vector* to = &buffer;
   for (int b = 0; b < 8; ++b)
   {
     std::array<std::size_t, 256>& count = counts[b];

@@ -10,6 +10,8 @@
 #ifndef rgmcSmoothing_h
 #define rgmcSmoothing_h
 
+#include "rgmcBuffer.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -129,7 +131,7 @@ template <typename Index = std::int64_t>
 struct Stencils
 {
   std::vector<std::int64_t> Offsets{ 0 };
-  std::vector<Index> Neighbours;
+  LargeVector<Index> Neighbours;
 
   void Add(const std::vector<Index>& neighbours)
   {
