@@ -5,7 +5,6 @@
 #ifndef vtkRGArrays_h
 #define vtkRGArrays_h
 
-#include "rgmcBuffer.h"
 #include "vtkAbstractArray.h"
 
 #include <algorithm>
@@ -16,7 +15,7 @@ namespace rgmc
 {
 
 /// Gives `array` (a vtkAOSDataArrayTemplate, its number of components set) storage for `values`
-/// values, uninitialized (huge pages asked for), and returns it.
+/// values, uninitialized, and returns it.
 template <typename ArrayT>
 typename ArrayT::ValueType* Allocate(ArrayT* array, vtkIdType values)
 {
@@ -27,7 +26,6 @@ typename ArrayT::ValueType* Allocate(ArrayT* array, vtkIdType values)
   {
     throw std::bad_alloc();
   }
-  AdviseHugePages(memory, static_cast<std::size_t>(values) * sizeof(Value));
   array->SetArray(static_cast<Value*>(memory), values, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
   return static_cast<Value*>(memory);
 }

@@ -836,7 +836,7 @@ private:
 
   /// Every vertex this rank owns, in gid order: its whole neighbourhood, its edges in the
   /// checks, its stencil row. Then the corner lists are released, unless the normals
-  /// will need them (`stencils`: the surface is smoothed).
+  /// will need them (`stencils`: the surface is smoothed) and they are 32-bit.
   void AssembleNeighbourhoods(
     const std::vector<std::vector<vtkIdType>>& received, bool stencils, Checks& checks)
   {
@@ -857,7 +857,9 @@ private:
         this->AddVertex(this->Numbering.SharedVertex[i], i, &edges, stencils, checks);
       }
     }
-    if (!stencils)
+    // Kept only when 32-bit: then they take the memory the 32-bit stencils saved, and the
+    // smoothing's peak stays where it was with 64-bit stencils and no corner lists.
+    if (!stencils || sizeof(I) > 4)
     {
       rgmc::LargeVector<I>().swap(this->Corners);
       std::vector<vtkIdType>().swap(this->CornerOffsets);
@@ -1636,7 +1638,7 @@ private:
   std::vector<bool> Partners; // the ranks that share a vertex with this one
 
   // The triangle corners at each vertex: made for the seams' analysis, kept for the normals
-  // when the surface is smoothed.
+  // when the surface is smoothed and I is 32-bit (else made again).
   std::vector<vtkIdType> CornerOffsets;
   rgmc::LargeVector<I> Corners;
   // One vertex's neighbourhood while it is analysed (on the calling thread).

@@ -44,8 +44,8 @@ inline void AdviseHugePages(void* data, std::size_t bytes)
 #endif
 }
 
-/// std::allocator for arrays that may be large (the surface's nodes): the same memory, with
-/// huge pages asked for (AdviseHugePages).
+/// std::allocator for large arrays (Seam Repair's per-vertex and per-triangle arrays): the same
+/// memory, with huge pages asked for (AdviseHugePages).
 template <typename T>
 struct LargeArrayAllocator
 {
@@ -132,7 +132,6 @@ public:
       }
       this->Data = grown;
       this->Capacity = capacity;
-      AdviseHugePages(grown, capacity * sizeof(T));
     }
   }
 
