@@ -35,7 +35,6 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkTypeInt32Array.h"
-#include "vtkTypeInt64Array.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
@@ -1859,11 +1858,13 @@ vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
     return other;
   };
   vtkDataArray* offsets = polys->GetOffsetsArray();
-  if (auto* o32 = vtkTypeInt32Array::FastDownCast(offsets))
+  // The AOS templates, not vtkTypeInt32Array and vtkTypeInt64Array: VTK 9.6's cell arrays keep
+  // their offsets in vtkAOSDataArrayTemplate<vtkTypeInt64>, which is not a vtkTypeInt64Array.
+  if (auto* o32 = vtkAOSDataArrayTemplate<vtkTypeInt32>::FastDownCast(offsets))
   {
     return count(o32->GetPointer(0));
   }
-  if (auto* o64 = vtkTypeInt64Array::FastDownCast(offsets))
+  if (auto* o64 = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(offsets))
   {
     return count(o64->GetPointer(0));
   }
