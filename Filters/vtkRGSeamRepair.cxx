@@ -34,7 +34,6 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkTypeInt32Array.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
@@ -2002,7 +2001,8 @@ bool vtkRGSeamRepair::RepairSeams(Run& run)
   vtkPoints* inputPoints = run.input->GetPoints();
   const bool doublePoints = inputPoints && inputPoints->GetDataType() == VTK_DOUBLE;
   const bool int32 = !run.vertices.Merged() &&
-    vtkTypeInt32Array::FastDownCast(run.input->GetPolys()->GetConnectivityArray());
+    vtkAOSDataArrayTemplate<std::int32_t>::FastDownCast(
+      run.input->GetPolys()->GetConnectivityArray());
   if (doublePoints)
   {
     return int32 ? this->RepairSeamsIn<double, std::int32_t>(run)
