@@ -1121,8 +1121,8 @@ private:
       }
       if (this->PendingRemote.size() >= static_cast<std::size_t>(std::numeric_limits<I>::max()))
       {
-        throw std::length_error("more neighbours held elsewhere than 32-bit indices can number "
-                                "in one piece");
+        throw std::length_error("more neighbours held elsewhere than the connectivity's index "
+                                "type can number in one piece");
       }
       this->Stencil.Neighbours.push_back(
         static_cast<I>(-1 - static_cast<std::int64_t>(this->PendingRemote.size())));
@@ -1161,8 +1161,8 @@ private:
     if (this->NumVertices + static_cast<vtkIdType>(this->RemoteGids.size()) >
       static_cast<vtkIdType>(std::numeric_limits<I>::max()))
     {
-      throw std::length_error("more vertices and neighbours held elsewhere than 32-bit indices "
-                              "can number in one piece");
+      throw std::length_error("more vertices and neighbours held elsewhere than the "
+                              "connectivity's index type can number in one piece");
     }
     for (I& s : this->Stencil.Neighbours)
     {

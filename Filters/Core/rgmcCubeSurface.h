@@ -10,7 +10,6 @@
 #ifndef rgmcCubeSurface_h
 #define rgmcCubeSurface_h
 
-#include "rgmcBuffer.h"
 #include "rgmcCaseTable.h"
 #include "rgmcGrid.h"
 #include "rgmcUnionFind.h"
@@ -82,10 +81,6 @@ struct SurfaceNode
   std::uint8_t Node;
   bool Degenerate;
 };
-
-/// The nodes growth found (a few per cube of the surface). A plain vector: huge pages made the
-/// extraction of the 54 M-triangle gyroid 40% slower (rgmcScale), for 5% on the 512^3 skull.
-using NodeList = std::vector<SurfaceNode>;
 
 /// The cube edge that runs along `axis` with its lower corner offset by du, dv (0 or 1) along
 /// the two other axes (in increasing axis order), from the corner and edge conventions.

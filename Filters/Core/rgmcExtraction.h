@@ -141,7 +141,7 @@ public:
   /// triangle counts and smallest keys. Slabs are cut into chunks of ChunkSlabs, extracted at
   /// once (on threads) and joined in chunk order, so that the result does not depend on the
   /// number of threads.
-  void Extract(NodeList& nodes)
+  void Extract(std::vector<SurfaceNode>& nodes)
   {
     if (nodes.empty() || this->Volume.Stopped())
     {
@@ -180,7 +180,7 @@ public:
     }
     {
       std::vector<std::int64_t> next(start.begin(), start.end() - 1);
-      NodeList sorted(nodes.size());
+      std::vector<SurfaceNode> sorted(nodes.size());
       for (const SurfaceNode& n : nodes)
       {
         sorted[next[n.K - box.Lo[2]]++] = n;
@@ -304,8 +304,8 @@ private:
     this->Pool.push_back(std::move(work));
   }
 
-  void ExtractChunk(const NodeList& nodes, const std::vector<std::int64_t>& start, int first,
-    int last, std::int64_t triangles, Chunk& chunk)
+  void ExtractChunk(const std::vector<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
+    int first, int last, std::int64_t triangles, Chunk& chunk)
   {
     const CellBox& box = this->NodeBox;
     std::unique_ptr<ChunkWork> taken = this->TakeWork();

@@ -75,7 +75,7 @@ public:
   }
 
   /// The nodes found: by round, then by tile, then in the order each tile found them.
-  NodeList& Nodes() { return this->Found; }
+  std::vector<SurfaceNode>& Nodes() { return this->Found; }
 
   /// Whether steps into cubes of other ranks are kept as departures (seeded growth on several
   /// ranks) instead of dropped.
@@ -806,7 +806,7 @@ private:
   std::int64_t Tiles[3] = { 0, 0, 0 }; // tiles along each axis of the owned box
   ZeroedArray<std::uint64_t> Visited;  // a bit per owned cube: its nodes were all found
   std::vector<TileWork> Work;          // per tile
-  NodeList Found;
+  std::vector<SurfaceNode> Found;
   std::vector<Departure> Departures;
   std::vector<std::int64_t> Pending; // tiles with crossings left by the budget, sorted
   std::int64_t Budget = std::numeric_limits<std::int64_t>::max();

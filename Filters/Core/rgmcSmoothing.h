@@ -132,12 +132,6 @@ struct Stencils
 {
   std::vector<std::int64_t> Offsets{ 0 };
   LargeVector<Index> Neighbours;
-
-  void Add(const std::vector<Index>& neighbours)
-  {
-    this->Neighbours.insert(this->Neighbours.end(), neighbours.begin(), neighbours.end());
-    this->Offsets.push_back(static_cast<std::int64_t>(this->Neighbours.size()));
-  }
 };
 
 // Each step below updates the rows [first, last) (all by default); rows are independent, so
