@@ -1803,14 +1803,12 @@ int vtkRGSeamRepair::RequestData(
     return 0;
   }
   this->UpdateProgress(0.05);
-  this->UpdateProgress(0.05);
   // PASS 1: this rank's distinct vertices and their global numbering.
   if (!this->NumberVertices(run))
   {
     vtkErrorMacro(<< "Cannot repair the seams: " << run.problem << ".");
     return 0;
   }
-  this->UpdateProgress(0.25);
   this->UpdateProgress(0.25);
   // PASS 2: how to tell edges on the volume's border.
   this->FindBorder(run);
@@ -1832,7 +1830,6 @@ int vtkRGSeamRepair::RequestData(
     output->Initialize();
     return 0;
   }
-  this->ReportChecks(run, output);
   this->ReportChecks(run, output);
   this->UpdateProgress(1.0);
   return 1;
