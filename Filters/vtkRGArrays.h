@@ -1,11 +1,14 @@
-// Storage for VTK arrays that fails with std::bad_alloc, as the rest of the filters' allocations
-// do. (VTK's own path reports a failed allocation through its error output, which needs memory
-// too: with the memory exhausted it aborted the process, measured in TestOutOfMemory.) Private to
-// the module.
+// Helpers for VTK arrays shared by the filters (private to the module): storage that fails with
+// std::bad_alloc, as the rest of the filters' allocations do (VTK's own path reports a failed
+// allocation through its error output, which needs memory too: with the memory exhausted it
+// aborted the process, measured in TestOutOfMemory), and the count of a cell array's cells that
+// are not triangles.
 #ifndef vtkRGArrays_h
 #define vtkRGArrays_h
 
+#include "vtkAOSDataArrayTemplate.h"
 #include "vtkAbstractArray.h"
+#include "vtkCellArray.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -28,6 +31,39 @@ typename ArrayT::ValueType* Allocate(ArrayT* array, vtkIdType values)
   }
   array->SetArray(static_cast<Value*>(memory), values, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
   return static_cast<Value*>(memory);
+}
+
+/// How many cells of `polys` do not have 3 points: from the offsets, read straight when they are
+/// 32- or 64-bit arrays (as VTK's cell arrays keep them), else cell by cell.
+inline vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
+{
+  const vtkIdType cells = polys->GetNumberOfCells();
+  auto count = [cells](const auto* offsets)
+  {
+    vtkIdType other = 0;
+    for (vtkIdType c = 0; c < cells; ++c)
+    {
+      other += offsets[c + 1] - offsets[c] != 3;
+    }
+    return other;
+  };
+  vtkDataArray* offsets = polys->GetOffsetsArray();
+  // The AOS templates, not vtkTypeInt32Array and vtkTypeInt64Array: VTK 9.6's cell arrays keep
+  // their offsets in vtkAOSDataArrayTemplate<vtkTypeInt64>, which is not a vtkTypeInt64Array.
+  if (auto* o32 = vtkAOSDataArrayTemplate<vtkTypeInt32>::FastDownCast(offsets))
+  {
+    return count(o32->GetPointer(0));
+  }
+  if (auto* o64 = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(offsets))
+  {
+    return count(o64->GetPointer(0));
+  }
+  vtkIdType other = 0;
+  for (vtkIdType c = 0; c < cells; ++c)
+  {
+    other += polys->GetCellSize(c) != 3;
+  }
+  return other;
 }
 
 } // namespace rgmc

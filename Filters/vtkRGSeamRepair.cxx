@@ -1836,45 +1836,6 @@ int vtkRGSeamRepair::RequestData(
 }
 
 //------------------------------------------------------------------------------
-namespace
-{
-
-/// How many cells of `polys` do not have 3 points: from the offsets, read straight when they are
-/// 32- or 64-bit arrays (as VTK's cell arrays keep them), else cell by cell.
-vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
-{
-  const vtkIdType cells = polys->GetNumberOfCells();
-  auto count = [cells](const auto* offsets)
-  {
-    vtkIdType other = 0;
-    for (vtkIdType c = 0; c < cells; ++c)
-    {
-      other += offsets[c + 1] - offsets[c] != 3;
-    }
-    return other;
-  };
-  vtkDataArray* offsets = polys->GetOffsetsArray();
-  // The AOS templates, not vtkTypeInt32Array and vtkTypeInt64Array: VTK 9.6's cell arrays keep
-  // their offsets in vtkAOSDataArrayTemplate<vtkTypeInt64>, which is not a vtkTypeInt64Array.
-  if (auto* o32 = vtkAOSDataArrayTemplate<vtkTypeInt32>::FastDownCast(offsets))
-  {
-    return count(o32->GetPointer(0));
-  }
-  if (auto* o64 = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(offsets))
-  {
-    return count(o64->GetPointer(0));
-  }
-  vtkIdType other = 0;
-  for (vtkIdType c = 0; c < cells; ++c)
-  {
-    other += polys->GetCellSize(c) != 3;
-  }
-  return other;
-}
-
-} // namespace
-
-//------------------------------------------------------------------------------
 bool vtkRGSeamRepair::CheckInput(Run& run)
 {
   Ranks& ranks = run.ranks;
@@ -1882,7 +1843,7 @@ bool vtkRGSeamRepair::CheckInput(Run& run)
   const vtkIdType verts = input->GetNumberOfVerts(), lines = input->GetNumberOfLines(),
                   strips = input->GetNumberOfStrips();
   vtkCellArray* polys = input->GetPolys();
-  const vtkIdType other = PolygonsNotTriangles(polys);
+  const vtkIdType other = rgmc::PolygonsNotTriangles(polys);
   if (verts || lines || strips || other)
   {
     std::ostringstream msg;
@@ -1953,7 +1914,12 @@ void vtkRGSeamRepair::FindBorder(Run& run)
   }
   border.Tolerance = 1e-6 * std::sqrt(diagonal);
   vtkIntArray* whole = vtkIntArray::SafeDownCast(input->GetFieldData()->GetArray("WholeExtent"));
-  if (run.keys && whole && whole->GetNumberOfValues() == 6)
+  // Only vtkRGMarchingCubes' keys say where a vertex is in the volume: global ids numbered
+  // otherwise (Seam Repair's own, vtkRGDecimate's) do not, though the extent passes with them.
+  vtkDataArray* keyArray = input->GetPointData()->GetGlobalIds();
+  const bool extractionKeys =
+    run.keys && keyArray && keyArray->GetName() && std::string(keyArray->GetName()) == "VertexKey";
+  if (extractionKeys && whole && whole->GetNumberOfValues() == 6)
   {
     border.Keys = true;
     for (int i = 0; i < 6; ++i)

@@ -1,0 +1,551 @@
+// Quadric-error edge collapse on one block (see rgmcDecimation.h).
+#include "rgmcDecimation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+namespace rgmc
+{
+
+Quadric Quadric::OfTriangle(const double a[3], const double b[3], const double c[3])
+{
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+  double n[3] = { u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0] };
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  Quadric q;
+  if (!(length > 0.0) || !std::isfinite(length))
+  {
+    return q;
+  }
+  n[0] /= length;
+  n[1] /= length;
+  n[2] /= length;
+  const double d = -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]);
+  q.Terms = { n[0] * n[0], n[0] * n[1], n[0] * n[2], n[0] * d, n[1] * n[1], n[1] * n[2], n[1] * d,
+    n[2] * n[2], n[2] * d, d * d };
+  return q;
+}
+
+Quadric Quadric::operator+(const Quadric& other) const
+{
+  Quadric sum;
+  for (int i = 0; i < 10; ++i)
+  {
+    sum.Terms[i] = this->Terms[i] + other.Terms[i];
+  }
+  return sum;
+}
+
+double Quadric::Error(const double p[3]) const
+{
+  const auto& q = this->Terms;
+  const double x = p[0], y = p[1], z = p[2];
+  return x * (q[0] * x + 2.0 * (q[1] * y + q[2] * z + q[3])) +
+    y * (q[4] * y + 2.0 * (q[5] * z + q[6])) + z * (q[7] * z + 2.0 * q[8]) + q[9];
+}
+
+namespace
+{
+
+std::array<int, 3> Rotated(const std::array<int, 3>& t)
+{
+  if (t[1] < t[0] && t[1] < t[2])
+  {
+    return { t[1], t[2], t[0] };
+  }
+  if (t[2] < t[0] && t[2] < t[1])
+  {
+    return { t[2], t[0], t[1] };
+  }
+  return t;
+}
+
+void Cross(const double* a, const double* b, const double* c, double n[3])
+{
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+  n[0] = u[1] * v[2] - u[2] * v[1];
+  n[1] = u[2] * v[0] - u[0] * v[2];
+  n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+// A candidate collapse in the queue; stale once either end has changed.
+struct Candidate
+{
+  double Cost;
+  int A, B; // A < B: the order of their global ids
+  unsigned StampA, StampB;
+  double Position[3];
+
+  // The queue's top is the cheapest, then the lowest (A, B).
+  bool operator<(const Candidate& other) const
+  {
+    if (this->Cost != other.Cost)
+    {
+      return this->Cost > other.Cost;
+    }
+    if (this->A != other.A)
+    {
+      return this->A > other.A;
+    }
+    return this->B > other.B;
+  }
+};
+
+// The mutable state of one simplification.
+class EdgeCollapser
+{
+public:
+  EdgeCollapser(const DecimationBlock& block, double maximumError)
+    : Points(block.Points)
+    , Quadrics(block.Quadrics)
+    , Triangles(block.Triangles)
+    , Owned(block.Triangles.size())
+    , MaximumCost(maximumError > 0.0 ? maximumError * maximumError : -1.0)
+  {
+    const std::size_t n = block.Ids.size();
+    this->Triangles.insert(this->Triangles.end(), block.Halo.begin(), block.Halo.end());
+    this->Star.resize(n);
+    for (std::size_t t = 0; t < this->Triangles.size(); ++t)
+    {
+      for (int v : this->Triangles[t])
+      {
+        this->Star[v].push_back(static_cast<int>(t));
+      }
+    }
+    this->Stamp.assign(n, 0);
+    this->Gone.assign(n, 0);
+    this->Movable.assign(n, 0);
+    for (std::size_t v = 0; v < n; ++v)
+    {
+      this->Movable[v] = !block.Fixed[v] && this->IsDisc(static_cast<int>(v));
+    }
+  }
+
+  std::vector<Collapse> Run()
+  {
+    std::vector<Collapse> log;
+    double level = 0.0;
+    // Sweeps: a candidate found invalid is dropped; once the queue is empty, every edge is
+    // queued again (some have become valid), until a sweep collapses nothing.
+    for (int sweep = 0; sweep < 4; ++sweep)
+    {
+      this->QueueAllEdges();
+      const std::size_t before = log.size();
+      while (!this->Queue.empty())
+      {
+        const Candidate c = this->Queue.top();
+        this->Queue.pop();
+        if (this->Gone[c.A] || this->Gone[c.B] || c.StampA != this->Stamp[c.A] ||
+          c.StampB != this->Stamp[c.B])
+        {
+          continue;
+        }
+        if (this->MaximumCost >= 0.0 && c.Cost > this->MaximumCost)
+        {
+          std::priority_queue<Candidate>().swap(this->Queue);
+          break;
+        }
+        if (!this->CanCollapse(c))
+        {
+          continue;
+        }
+        this->CollapseEdge(c);
+        level = std::max(level, c.Cost);
+        log.push_back(Collapse{ c.B, c.A, { c.Position[0], c.Position[1], c.Position[2] }, level });
+        this->QueueEdgesAround(c.A);
+      }
+      if (log.size() == before)
+      {
+        break;
+      }
+    }
+    return log;
+  }
+
+private:
+  std::vector<double> Points;
+  std::vector<Quadric> Quadrics;
+  std::vector<std::array<int, 3>> Triangles; // own, then halo
+  std::size_t Owned;
+  double MaximumCost;
+  std::vector<std::vector<int>> Star; // the live triangles around each vertex
+  std::vector<unsigned> Stamp;
+  std::vector<std::uint8_t> Gone, Movable;
+  std::priority_queue<Candidate> Queue;
+  std::vector<int> NeighboursA, NeighboursB; // scratch
+
+  const double* Point(int v) const { return this->Points.data() + 3 * v; }
+
+  // Whether the triangles around v are all the block's own and form one closed fan.
+  bool IsDisc(int v) const
+  {
+    const auto& star = this->Star[v];
+    if (star.size() < 3)
+    {
+      return false;
+    }
+    std::vector<std::pair<int, int>> link; // (next, previous) corners around v
+    for (int t : star)
+    {
+      if (static_cast<std::size_t>(t) >= this->Owned)
+      {
+        return false;
+      }
+      const auto& tri = this->Triangles[t];
+      const int i = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
+      link.emplace_back(tri[(i + 1) % 3], tri[(i + 2) % 3]);
+    }
+    // One cycle: every corner starts exactly one link edge and ends exactly one, and walking
+    // from the first comes back after all of them.
+    std::size_t steps = 0;
+    int at = link[0].second;
+    do
+    {
+      int found = -1;
+      for (std::size_t e = 0; e < link.size(); ++e)
+      {
+        if (link[e].first == at)
+        {
+          if (found >= 0)
+          {
+            return false;
+          }
+          found = static_cast<int>(e);
+        }
+      }
+      if (found < 0)
+      {
+        return false;
+      }
+      at = link[found].second;
+      ++steps;
+    } while (at != link[0].second && steps <= link.size());
+    return steps == link.size();
+  }
+
+  void Neighbours(int v, std::vector<int>& out) const
+  {
+    out.clear();
+    for (int t : this->Star[v])
+    {
+      for (int w : this->Triangles[t])
+      {
+        if (w != v)
+        {
+          out.push_back(w);
+        }
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+  // The best position for the merged vertex of a and b and its error: the quadric's minimum when
+  // well defined and near the edge, else the best of the midpoint and the two ends.
+  Candidate Evaluate(int a, int b) const
+  {
+    Candidate c;
+    c.A = a;
+    c.B = b;
+    c.StampA = this->Stamp[a];
+    c.StampB = this->Stamp[b];
+    const Quadric q = this->Quadrics[a] + this->Quadrics[b];
+    const auto& m = q.Terms;
+    const double* pa = this->Point(a);
+    const double* pb = this->Point(b);
+    const double mid[3] = { 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2]) };
+    // A x = -b by Cramer's rule, for a well conditioned A only.
+    const double c00 = m[4] * m[7] - m[5] * m[5];
+    const double c01 = m[2] * m[5] - m[1] * m[7];
+    const double c02 = m[1] * m[5] - m[2] * m[4];
+    const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+    const double trace = m[0] + m[4] + m[7];
+    const double edge2 = (pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
+      (pa[2] - pb[2]) * (pa[2] - pb[2]);
+    bool solved = false;
+    if (trace > 0.0 && std::abs(det) > 1e-6 * trace * trace * trace)
+    {
+      const double c11 = m[0] * m[7] - m[2] * m[2];
+      const double c12 = m[1] * m[2] - m[0] * m[5];
+      const double c22 = m[0] * m[4] - m[1] * m[1];
+      const double r[3] = { -m[3], -m[6], -m[8] };
+      const double x[3] = { (c00 * r[0] + c01 * r[1] + c02 * r[2]) / det,
+        (c01 * r[0] + c11 * r[1] + c12 * r[2]) / det,
+        (c02 * r[0] + c12 * r[1] + c22 * r[2]) / det };
+      const double d2 = (x[0] - mid[0]) * (x[0] - mid[0]) + (x[1] - mid[1]) * (x[1] - mid[1]) +
+        (x[2] - mid[2]) * (x[2] - mid[2]);
+      if (std::isfinite(d2) && d2 <= edge2)
+      {
+        std::copy(x, x + 3, c.Position);
+        c.Cost = q.Error(x);
+        solved = true;
+      }
+    }
+    if (!solved)
+    {
+      const double* options[3] = { mid, pa, pb };
+      c.Cost = q.Error(mid);
+      std::copy(mid, mid + 3, c.Position);
+      for (int i = 1; i < 3; ++i)
+      {
+        const double e = q.Error(options[i]);
+        if (e < c.Cost)
+        {
+          c.Cost = e;
+          std::copy(options[i], options[i] + 3, c.Position);
+        }
+      }
+    }
+    c.Cost = std::isfinite(c.Cost) ? std::max(0.0, c.Cost) : HUGE_VAL;
+    return c;
+  }
+
+  void QueueAllEdges()
+  {
+    for (std::size_t t = 0; t < this->Owned; ++t)
+    {
+      const auto& tri = this->Triangles[t];
+      if (tri[0] == tri[1])
+      {
+        continue; // collapsed
+      }
+      for (int i = 0; i < 3; ++i)
+      {
+        const int p = tri[i], q = tri[(i + 1) % 3];
+        // Each edge of a consistently oriented fan once: from its lower end.
+        if (p < q && this->Movable[p] && this->Movable[q])
+        {
+          this->Queue.push(this->Evaluate(p, q));
+        }
+      }
+    }
+  }
+
+  void QueueEdgesAround(int v)
+  {
+    std::vector<int>& around = this->NeighboursA;
+    this->Neighbours(v, around);
+    for (int w : around)
+    {
+      if (this->Movable[w])
+      {
+        this->Queue.push(v < w ? this->Evaluate(v, w) : this->Evaluate(w, v));
+      }
+    }
+  }
+
+  bool CanCollapse(const Candidate& c)
+  {
+    const int a = c.A, b = c.B;
+    // The edge's two triangles and their third corners.
+    int opposite[2], shared = 0;
+    for (int t : this->Star[a])
+    {
+      const auto& tri = this->Triangles[t];
+      if (tri[0] == b || tri[1] == b || tri[2] == b)
+      {
+        if (shared == 2)
+        {
+          return false;
+        }
+        opposite[shared++] =
+          tri[0] != a && tri[0] != b ? tri[0] : (tri[1] != a && tri[1] != b ? tri[1] : tri[2]);
+      }
+    }
+    if (shared != 2 || opposite[0] == opposite[1])
+    {
+      return false;
+    }
+    // The link condition: a and b have no common neighbour but the two corners.
+    this->Neighbours(a, this->NeighboursA);
+    this->Neighbours(b, this->NeighboursB);
+    int common = 0;
+    for (std::size_t i = 0, j = 0; i < this->NeighboursA.size() && j < this->NeighboursB.size();)
+    {
+      if (this->NeighboursA[i] < this->NeighboursB[j])
+      {
+        ++i;
+      }
+      else if (this->NeighboursB[j] < this->NeighboursA[i])
+      {
+        ++j;
+      }
+      else
+      {
+        ++common;
+        ++i;
+        ++j;
+      }
+    }
+    if (common != 2)
+    {
+      return false;
+    }
+    // Each corner keeps at least three neighbours.
+    if (this->Star[opposite[0]].size() < 4 || this->Star[opposite[1]].size() < 4)
+    {
+      return false;
+    }
+    // No triangle that stays turns over or becomes degenerate.
+    for (int end : { a, b })
+    {
+      for (int t : this->Star[end])
+      {
+        const auto& tri = this->Triangles[t];
+        const bool both = (tri[0] == a || tri[1] == a || tri[2] == a) &&
+          (tri[0] == b || tri[1] == b || tri[2] == b);
+        if (both)
+        {
+          continue;
+        }
+        const double* p[3];
+        const double* moved[3];
+        for (int i = 0; i < 3; ++i)
+        {
+          p[i] = this->Point(tri[i]);
+          moved[i] = tri[i] == end ? c.Position : p[i];
+        }
+        double before[3], after[3];
+        Cross(p[0], p[1], p[2], before);
+        Cross(moved[0], moved[1], moved[2], after);
+        const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
+        if (!(dot > 0.0))
+        {
+          return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  void CollapseEdge(const Candidate& c)
+  {
+    const int a = c.A, b = c.B;
+    this->Quadrics[a] = this->Quadrics[a] + this->Quadrics[b];
+    std::copy(c.Position, c.Position + 3, this->Points.begin() + 3 * a);
+    auto drop = [this](int v, int t)
+    {
+      auto& star = this->Star[v];
+      star.erase(std::find(star.begin(), star.end(), t));
+    };
+    for (int t : this->Star[b])
+    {
+      auto& tri = this->Triangles[t];
+      if (tri[0] == a || tri[1] == a || tri[2] == a)
+      {
+        for (int w : tri)
+        {
+          if (w != b)
+          {
+            drop(w, t);
+          }
+        }
+        tri = { -1, -1, -1 };
+      }
+      else
+      {
+        for (int& w : tri)
+        {
+          w = w == b ? a : w;
+        }
+        this->Star[a].push_back(t);
+      }
+    }
+    this->Star[b].clear();
+    this->Gone[b] = 1;
+    ++this->Stamp[a];
+    ++this->Stamp[b];
+  }
+};
+
+} // namespace
+
+void DecimationBlock::SortTriangles()
+{
+  for (auto* list : { &this->Triangles, &this->Halo })
+  {
+    for (auto& t : *list)
+    {
+      t = Rotated(t);
+    }
+    std::sort(list->begin(), list->end());
+  }
+  this->Halo.erase(std::unique(this->Halo.begin(), this->Halo.end()), this->Halo.end());
+}
+
+void DecimationBlock::ComputeQuadrics()
+{
+  const std::size_t n = this->Ids.size();
+  this->Quadrics.assign(n, Quadric());
+  std::vector<std::uint8_t> used(n, 0);
+  for (const auto& t : this->Triangles)
+  {
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  }
+  // Own and halo triangles merged in canonical order, so that a vertex seen by several blocks
+  // gets the same sum in each.
+  std::vector<std::array<int, 3>> all(this->Triangles);
+  all.insert(all.end(), this->Halo.begin(), this->Halo.end());
+  std::sort(all.begin(), all.end());
+  for (const auto& t : all)
+  {
+    if (!used[t[0]] && !used[t[1]] && !used[t[2]])
+    {
+      continue;
+    }
+    const double* p = this->Points.data();
+    const Quadric q = Quadric::OfTriangle(p + 3 * t[0], p + 3 * t[1], p + 3 * t[2]);
+    for (int v : t)
+    {
+      if (used[v])
+      {
+        this->Quadrics[v] = this->Quadrics[v] + q;
+      }
+    }
+  }
+}
+
+std::vector<Collapse> Simplify(const DecimationBlock& block, double maximumError)
+{
+  return EdgeCollapser(block, maximumError).Run();
+}
+
+void ApplyCollapses(DecimationBlock& block, const std::vector<Collapse>& log, std::size_t count)
+{
+  std::vector<int> into(block.Ids.size());
+  for (std::size_t v = 0; v < into.size(); ++v)
+  {
+    into[v] = static_cast<int>(v);
+  }
+  for (std::size_t i = 0; i < count && i < log.size(); ++i)
+  {
+    const Collapse& c = log[i];
+    block.Quadrics[c.Kept] = block.Quadrics[c.Kept] + block.Quadrics[c.Removed];
+    std::copy(c.Position, c.Position + 3, block.Points.begin() + 3 * c.Kept);
+    into[c.Removed] = c.Kept;
+  }
+  auto find = [&into](int v)
+  {
+    while (into[v] != v)
+    {
+      into[v] = into[into[v]];
+      v = into[v];
+    }
+    return v;
+  };
+  std::size_t kept = 0;
+  for (const auto& t : block.Triangles)
+  {
+    const std::array<int, 3> m = { find(t[0]), find(t[1]), find(t[2]) };
+    if (m[0] != m[1] && m[1] != m[2] && m[0] != m[2])
+    {
+      block.Triangles[kept++] = m;
+    }
+  }
+  block.Triangles.resize(kept);
+}
+
+} // namespace rgmc

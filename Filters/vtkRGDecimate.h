@@ -1,0 +1,144 @@
+/**
+ * @class   vtkRGDecimate
+ * @brief   quadric-error decimation of a distributed surface, the same on any number of ranks
+ *
+ * Reduces a triangle surface numbered as one mesh (vtkRGSeamRepair's output: `GlobalPointIds`
+ * on every rank) to a fraction of its triangles by edge collapses chosen by their quadric error
+ * (Garland and Heckbert, "Surface simplification using quadric error metrics", SIGGRAPH 1997):
+ * each vertex carries the sum of the squared-distance quadrics of the triangles merged into it,
+ * and the cheapest collapse goes first, the merged vertex placed where its quadric is smallest.
+ *
+ * What is kept:
+ * - a closed manifold stays one, of the same topology: a collapse is made only when the edge's
+ *   ends share no neighbour but the two corners of its triangles (the link condition) and no
+ *   vertex is left with fewer than three neighbours, so no component shrinks away or pinches;
+ * - no triangle turns over (its normal after a collapse keeps a positive dot product with its
+ *   normal before);
+ * - vertices on a boundary edge (where the surface leaves the volume) or a non-manifold edge
+ *   neither move nor go, so the border stays where it is;
+ * - the output is the same, to the bit and in the same order, for any number of ranks and
+ *   threads, and it is one mesh across the ranks (global point ids, normals), as vtkRGSeamRepair
+ *   makes it, so the Merged Surface Writer writes it as one file.
+ *
+ * ### Distributed execution
+ * Problem: a greedy edge collapse is sequential, and the surface is spread over ranks in a way
+ * that depends on their number.
+ * Approach: space is cut into cubic blocks on a grid that depends only on the surface (its global
+ * bounds and triangle count). A triangle belongs to the block of its lowest-numbered vertex.
+ * Each block is simplified greedily on its own, with the vertices it shares with other blocks
+ * fixed, so blocks are independent: their result does not depend on where or in what order they
+ * are simplified. A second and a third pass with the grid shifted by half and a quarter block
+ * simplify what the first left fixed. In each pass, how many collapses each block keeps is set by
+ * one threshold on the collapses' error over all blocks (a distributed selection, ties broken by
+ * block and order), so the cheapest collapses of the whole surface are the ones made and the
+ * triangle count lands on the target.
+ * Steps of a pass:
+ * 1. Count the triangles of each block (AllReduce); blocks go to ranks in contiguous ranges of
+ *    balanced counts.
+ * 2. Send each triangle, with its vertices' positions and quadrics, to its block's rank.
+ * 3. Find the vertices shared by several blocks: (vertex, block) pairs go to the rank of the
+ *    vertex (its global id modulo the ranks), which answers each block with the other blocks.
+ * 4. Send each block the other blocks' triangles around its shared vertices (its halo).
+ * 5. Simplify the blocks (threads over blocks); select the threshold (AllReduce, bisection on the
+ *    error's bits); keep each block's collapses up to it.
+ * After the last pass the pieces are numbered as one mesh by an internal vtkRGSeamRepair (no
+ * smoothing), which also recomputes normals and the checks and measures in field data.
+ * Nothing is gathered on one rank; a rank's memory follows its share of the blocks. Errors are
+ * agreed on every rank.
+ *
+ * @warning The error bound (MaximumError) is on the quadric error: the root of the sum of the
+ * squared distances from a merged vertex to the planes of the original triangles merged into it,
+ * not the Hausdorff distance, which can be larger where planes extend beyond their triangles.
+ *
+ * @sa vtkRGSeamRepair vtkQuadricDecimation vtkDecimatePro
+ */
+
+#ifndef vtkRGDecimate_h
+#define vtkRGDecimate_h
+
+#include "RGMCFiltersModule.h" // For export macro
+#include "vtkPolyDataAlgorithm.h"
+
+class vtkMultiProcessController;
+
+class RGMCFILTERS_EXPORT vtkRGDecimate : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkRGDecimate* New();
+  vtkTypeMacro(vtkRGDecimate, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * The fraction of the triangles to remove, greater than 0 and less than 1 (default 0.9: keep
+   * a tenth). Fewer go when MaximumError stops the collapses first, or when no more collapse
+   * keeps the surface valid.
+   */
+  vtkSetMacro(TargetReduction, double);
+  vtkGetMacro(TargetReduction, double);
+  ///@}
+
+  ///@{
+  /**
+   * The largest quadric error of a collapse, in world units (default 0: no limit); see the
+   * warning above.
+   */
+  vtkSetMacro(MaximumError, double);
+  vtkGetMacro(MaximumError, double);
+  ///@}
+
+  ///@{
+  /**
+   * About how many triangles a block holds (default 20000; at least 100): the grid's cubes are
+   * sized for this many on a surface spanning its bounds. Smaller blocks spread over more ranks
+   * and threads, larger ones leave fewer vertices fixed at their faces. The result depends on
+   * it, never on the number of ranks or threads.
+   */
+  vtkSetClampMacro(TrianglesPerBlock, vtkIdType, 100, VTK_ID_MAX);
+  vtkGetMacro(TrianglesPerBlock, vtkIdType);
+  ///@}
+
+  ///@{
+  /**
+   * The controller that links the ranks (default: the global controller).
+   */
+  void SetController(vtkMultiProcessController*);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
+  /**
+   * The collective calls this rank made in the last execution: the same on every rank.
+   */
+  vtkGetMacro(NumberOfCollectives, vtkIdType);
+
+protected:
+  vtkRGDecimate();
+  ~vtkRGDecimate() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double TargetReduction = 0.9;
+  double MaximumError = 0.0;
+  vtkIdType TrianglesPerBlock = 20000;
+  vtkMultiProcessController* Controller = nullptr;
+  vtkIdType NumberOfCollectives = 0;
+
+private:
+  vtkRGDecimate(const vtkRGDecimate&) = delete;
+  void operator=(const vtkRGDecimate&) = delete;
+
+  // The passes of RequestData, in order (the collective schedule is written above it). Each
+  // returns false on every rank alike, with the problem in the run.
+  struct Run;
+  bool CheckInput(Run& run);
+  bool ReadSurface(Run& run);
+  bool PlaceBlocks(Run& run, int pass);
+  bool SendTriangles(Run& run);
+  bool FindSharedVertices(Run& run);
+  bool SendHalos(Run& run);
+  bool SimplifyBlocks(Run& run);
+  bool KeepCheapest(Run& run, bool last);
+  bool NumberSurface(Run& run, vtkPolyData* output);
+};
+
+#endif
