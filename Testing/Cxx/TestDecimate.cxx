@@ -47,6 +47,7 @@ struct Surface
   double Isovalue;
   int Mode;
   Seeds SeedPoints;
+  bool Thick; // no two sheets of the surface closer than a voxel
 };
 
 double Ball(int i, int j, int k, const double c[3], double radius)
@@ -59,7 +60,7 @@ std::vector<Surface> Surfaces()
 {
   std::vector<Surface> surfaces;
   surfaces.push_back(Surface{ "skull", [](const int extent[6]) { return PhantomPiece(extent, 65); },
-    400.0, vtkRGMarchingCubes::SEEDED, { { 0, 0, 105 } } });
+    400.0, vtkRGMarchingCubes::SEEDED, { { 0, 0, 105 } }, false });
   surfaces.push_back(Surface{ "torus",
     [](const int extent[6])
     {
@@ -70,7 +71,7 @@ std::vector<Surface> Surfaces()
           return 7.2 - std::sqrt((rho - 18.0) * (rho - 18.0) + (k - 32.4) * (k - 32.4));
         });
     },
-    0.0, vtkRGMarchingCubes::SEEDED, { { 50.0, 32.0, 32.0 } } });
+    0.0, vtkRGMarchingCubes::SEEDED, { { 50.0, 32.0, 32.0 } }, true });
   surfaces.push_back(Surface{ "five spheres",
     [](const int extent[6])
     {
@@ -87,7 +88,7 @@ std::vector<Surface> Surfaces()
           return f;
         });
     },
-    0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {} });
+    0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}, true });
   // Centred on the volume's face x = 0: open there, along a circle on the border.
   surfaces.push_back(Surface{ "sphere cut by the border",
     [](const int extent[6])
@@ -99,7 +100,7 @@ std::vector<Surface> Surfaces()
           return Ball(i, j, k, c, 25.3);
         });
     },
-    0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {} });
+    0.0, vtkRGMarchingCubes::ALL_COMPONENTS, {}, true });
   return surfaces;
 }
 
@@ -484,10 +485,15 @@ int main(int argc, char* argv[])
                 << d.Output->GetFieldData()->GetArray("DecimationQuadricError")->GetTuple1(0)
                 << ", farthest vertex "
                 << FarthestVertex(AsPolyData(reference), AsPolyData(input).GetPointer()) << "\n";
-      // Facing the same way: no triangle turned over.
-      const long long away = FacingAway(AsPolyData(reference), AsPolyData(input).GetPointer());
-      RGMC_CHECK(away == 0,
-        surface.Name << ": " << away << " triangles face away from the original surface");
+      // Facing the same way: no triangle turned over. (Where two sheets of the surface are
+      // closer than a voxel, as the phantom skull's thin bone at 64^3 is, the nearest original
+      // triangle can be on the other sheet: not a test there.)
+      if (surface.Thick)
+      {
+        const long long away = FacingAway(AsPolyData(reference), AsPolyData(input).GetPointer());
+        RGMC_CHECK(away == 0,
+          surface.Name << ": " << away << " triangles face away from the original surface");
+      }
       // As far as it goes: still closed and of the same topology.
       {
         const Decimated most = Decimate(single, repaired, 0.9999);
