@@ -2,6 +2,7 @@
 // grid that depends on the surface alone (see the header for the scheme).
 #include "vtkRGDecimate.h"
 #include "rgmcDecimation.h"
+#include "rgmcRadixSort.h"
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 #include "vtkRGCompatibility.h"
@@ -61,27 +62,28 @@ constexpr int MaximumBlocksPerAxis = 32;
 constexpr double PassOffsets[] = { 0.0, 0.5, 0.25, 0.75, 0.125, 0.625 };
 constexpr int Passes = 6;
 
-/// A vertex as it travels: global id, position and quadric.
+/// A vertex as it travels: global id, position and, once there is one, quadric.
 struct Vertex
 {
   vtkIdType Id;
   double Point[3];
   rgmc::Quadric Quadric;
 
-  static constexpr std::size_t Words = 14;
-  void Write(std::vector<vtkIdType>& words) const
+  /// Message words of a vertex: id and position, then the quadric's 10 terms when it has one.
+  static std::size_t Words(bool quadric) { return quadric ? 14 : 4; }
+  void Write(std::vector<vtkIdType>& words, bool quadric) const
   {
     words.push_back(this->Id);
     for (double x : this->Point)
     {
       words.push_back(rgmc::WordOf(x));
     }
-    for (double x : this->Quadric.Terms)
+    for (std::size_t i = 0; quadric && i < this->Quadric.Terms.size(); ++i)
     {
-      words.push_back(rgmc::WordOf(x));
+      words.push_back(rgmc::WordOf(this->Quadric.Terms[i]));
     }
   }
-  static Vertex Read(const vtkIdType* words)
+  static Vertex Read(const vtkIdType* words, bool quadric)
   {
     Vertex v;
     v.Id = words[0];
@@ -89,22 +91,59 @@ struct Vertex
     {
       v.Point[i] = rgmc::RealOf(words[1 + i]);
     }
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; quadric && i < 10; ++i)
     {
       v.Quadric.Terms[i] = rgmc::RealOf(words[4 + i]);
     }
     return v;
   }
-  bool operator<(const Vertex& other) const { return this->Id < other.Id; }
 };
 
-/// Sorts records by id and keeps one of each (copies of a vertex are equal).
-void SortUnique(std::vector<Vertex>& vertices)
+/// A global id as a radix-sort key, in the ids' signed order.
+std::uint64_t KeyOf(vtkIdType id)
 {
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end(),
-                   [](const Vertex& a, const Vertex& b) { return a.Id == b.Id; }),
-    vertices.end());
+  return static_cast<std::uint64_t>(id) ^ (std::uint64_t(1) << 63);
+}
+
+/// Sorts records by id and keeps one of each (copies of a vertex are equal). The records are
+/// large: their ids and places are sorted, then the records moved once.
+void SortUnique(std::vector<Vertex>& vertices, std::size_t sortedPrefix = 0)
+{
+  auto byId = [](const Vertex& a, const Vertex& b) { return a.Id < b.Id; };
+  auto sameId = [](const Vertex& a, const Vertex& b) { return a.Id == b.Id; };
+  // Mostly in order already (what came from one rank, or a sorted part and a few more): merge.
+  const auto tail = vertices.begin() + static_cast<std::ptrdiff_t>(sortedPrefix);
+  if (std::is_sorted(tail, vertices.end(), byId) || vertices.size() - sortedPrefix < 4096)
+  {
+    std::sort(tail, vertices.end(), byId);
+    std::inplace_merge(vertices.begin(), tail, vertices.end(), byId);
+    vertices.erase(std::unique(vertices.begin(), vertices.end(), sameId), vertices.end());
+    return;
+  }
+  std::vector<std::pair<vtkIdType, std::size_t>> order(vertices.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+  {
+    order[i] = { vertices[i].Id, i };
+  }
+  rgmc::RadixSort(order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); });
+  std::vector<Vertex> sorted;
+  sorted.reserve(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+  {
+    if (i == 0 || order[i].first != order[i - 1].first)
+    {
+      sorted.push_back(vertices[order[i].second]);
+    }
+  }
+  vertices.swap(sorted);
+}
+
+/// Sorted distinct ids.
+template <typename Id>
+void SortDistinct(std::vector<Id>& ids)
+{
+  rgmc::RadixSort(ids, [](Id id) { return KeyOf(static_cast<vtkIdType>(id)); });
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
 }
 
 const Vertex* Find(const std::vector<Vertex>& vertices, vtkIdType id)
@@ -410,8 +449,8 @@ bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
     grid.Origin[a] = run.lower[a];
   }
   const int perAxis = static_cast<int>(std::min<double>(MaximumBlocksPerAxis,
-    std::max(1.0,
-      std::ceil(std::sqrt(static_cast<double>(run.triangles) / this->TrianglesPerBlock)))));
+    std::max(
+      1.0, std::ceil(std::sqrt(static_cast<double>(run.triangles) / this->TrianglesPerBlock)))));
   grid.Size = longest > 0 ? longest / perAxis : 1.0;
   for (int a = 0; a < 3; ++a)
   {
@@ -485,11 +524,10 @@ bool vtkRGDecimate::SendTriangles(Run& run)
               words.insert(words.end(), run.surface[t].begin(), run.surface[t].end());
               ids.insert(ids.end(), run.surface[t].begin(), run.surface[t].end());
             }
-            std::sort(ids.begin(), ids.end());
-            ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+            SortDistinct(ids);
             for (vtkIdType id : ids)
             {
-              Find(run.vertices, id)->Write(words);
+              Find(run.vertices, id)->Write(words, run.quadrics);
             }
           }
           std::vector<Triangle>().swap(run.surface);
@@ -522,9 +560,10 @@ bool vtkRGDecimate::SendTriangles(Run& run)
           }
           block->Own.push_back({ words[at + 1], words[at + 2], words[at + 3] });
         }
-        for (; at + Vertex::Words <= words.size(); at += Vertex::Words)
+        const std::size_t size = Vertex::Words(run.quadrics);
+        for (; at + size <= words.size(); at += size)
         {
-          run.seen.push_back(Vertex::Read(words.data() + at));
+          run.seen.push_back(Vertex::Read(words.data() + at, run.quadrics));
         }
       }
     });
@@ -547,8 +586,7 @@ bool vtkRGDecimate::FindSharedVertices(Run& run)
             {
               ids.insert(ids.end(), t.begin(), t.end());
             }
-            std::sort(ids.begin(), ids.end());
-            ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+            SortDistinct(ids);
             for (vtkIdType id : ids)
             {
               auto& words = outgoing[static_cast<std::size_t>(id % size)];
@@ -674,11 +712,10 @@ bool vtkRGDecimate::SendHalos(Run& run)
               words.insert(words.end(), t.begin(), t.end());
               ids.insert(ids.end(), t.begin(), t.end());
             }
-            std::sort(ids.begin(), ids.end());
-            ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+            SortDistinct(ids);
             for (vtkIdType id : ids)
             {
-              Find(run.seen, id)->Write(words);
+              Find(run.seen, id)->Write(words, run.quadrics);
             }
           }
         }))
@@ -686,6 +723,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
     return false;
   }
   const auto incoming = run.ranks.Exchange(outgoing, Everyone(size), HaloTag);
+  const std::size_t seenBefore = run.seen.size();
   outgoing.clear();
   return run.ranks.Step("assemble the blocks", run.problem,
     [&]()
@@ -707,12 +745,13 @@ bool vtkRGDecimate::SendHalos(Run& run)
           }
           block->Halo.push_back({ words[at + 1], words[at + 2], words[at + 3] });
         }
-        for (; at + Vertex::Words <= words.size(); at += Vertex::Words)
+        const std::size_t size = Vertex::Words(run.quadrics);
+        for (; at + size <= words.size(); at += size)
         {
-          run.seen.push_back(Vertex::Read(words.data() + at));
+          run.seen.push_back(Vertex::Read(words.data() + at, run.quadrics));
         }
       }
-      SortUnique(run.seen);
+      SortUnique(run.seen, seenBefore);
       rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
         [&](vtkIdType first, vtkIdType last)
         {
@@ -727,8 +766,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
                 mesh.Ids.insert(mesh.Ids.end(), t.begin(), t.end());
               }
             }
-            std::sort(mesh.Ids.begin(), mesh.Ids.end());
-            mesh.Ids.erase(std::unique(mesh.Ids.begin(), mesh.Ids.end()), mesh.Ids.end());
+            SortDistinct(mesh.Ids);
             const std::size_t n = mesh.Ids.size();
             mesh.Points.resize(3 * n);
             mesh.Quadrics.resize(n);
@@ -773,6 +811,11 @@ bool vtkRGDecimate::SendHalos(Run& run)
 bool vtkRGDecimate::SimplifyBlocks(Run& run)
 {
   const double maximumError = this->MaximumError;
+  // No block needs more collapses than the whole surface still needs; and a block is stopped at
+  // four times its share of them (a rule of global counts only, so the same on any ranks): the
+  // passes after the first need few collapses, and would otherwise simplify every block as far
+  // as it goes to keep a handful.
+  const double needed = 0.5 * static_cast<double>(run.triangles - run.target);
   return run.ranks.Step("simplify the blocks", run.problem,
     [&]()
     {
@@ -781,7 +824,11 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run)
         {
           for (vtkIdType b = first; b < last; ++b)
           {
-            run.blocks[b].Log = rgmc::Simplify(run.blocks[b].Mesh, maximumError);
+            Block& block = run.blocks[b];
+            const double share = 4.0 * needed * static_cast<double>(run.blockTriangles[block.Id]) /
+              static_cast<double>(run.triangles);
+            block.Log = rgmc::Simplify(block.Mesh, maximumError,
+              static_cast<std::size_t>(std::ceil(std::min(needed, share))));
           }
         });
     });
@@ -791,7 +838,7 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run)
 // How many collapses each block keeps: the cheapest over all blocks, by their level (the largest
 // error so far in their block), ties by block and order; then the kept collapses are applied and
 // the blocks' triangles become this rank's surface.
-bool vtkRGDecimate::KeepCheapest(Run& run, bool last)
+bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
 {
   Ranks& ranks = run.ranks;
   // Collapses found, and the blocks' vertices, fixed or not.
@@ -817,7 +864,8 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool last)
   // needed, so that it does not decimate the blocks' insides further than the whole surface
   // will be (the next passes free the rest).
   vtkIdType needed = (run.triangles - run.target + 1) / 2;
-  if (!last && sums[1] > 0)
+  // The last few (5% of the triangles or less) are made at once.
+  if (!all && 2 * needed > run.triangles / 20 && sums[1] > 0)
   {
     needed = static_cast<vtkIdType>(
       std::ceil(static_cast<double>(needed) * static_cast<double>(sums[1] - sums[2]) / sums[1]));

@@ -137,7 +137,7 @@ private:
   bool FindSharedVertices(Run& run);
   bool SendHalos(Run& run);
   bool SimplifyBlocks(Run& run);
-  bool KeepCheapest(Run& run, bool last);
+  bool KeepCheapest(Run& run, bool all);
   bool NumberSurface(Run& run, vtkPolyData* output);
 };
 

@@ -9,6 +9,10 @@ reads the volume, grows the surface through the vertex nearest to each seed (Reg
 Marching Cubes, on --ranks MPI ranks), makes the pieces one watertight mesh and smooths it (Seam
 Repair), writes <output>.stl and <output>.vtp (one mesh, seam vertices merged) and
 <output>.json (what was done, the mesh checks, timings) and, with --screenshot, a picture.
+--decimate FRACTION (and/or --max-error DISTANCE) reduces the mesh before it is written (Decimate
+Surface: quadric-error edge collapses, closed and the same on any number of ranks); the report
+then has the triangles before and after, the distances to the undecimated surface and the
+volume's change.
 --input also takes a DICOM series (a directory, or one of its files) and a NIfTI-1 file
 (.nii, .nii.gz), read by the plugin's distributed readers (each rank reads its own slices).
 Rendering needs an X server (run under xvfb-run when there is no display).
@@ -71,6 +75,14 @@ def parse_args(argv):
                         "0.01), sinc (windowed sinc, no shrinkage) or none")
     parser.add_argument("--iterations", type=int, default=20,
                         help="smoothing iterations (default 20)")
+    parser.add_argument("--decimate", type=float, metavar="FRACTION",
+                        help="remove this fraction of the triangles (between 0 and 1, e.g. 0.9 "
+                        "keeps a tenth) after smoothing, keeping the mesh closed (Decimate "
+                        "Surface)")
+    parser.add_argument("--max-error", type=float, metavar="DISTANCE",
+                        help="decimate with at most this quadric error per collapse (world "
+                        "units); with --decimate, whichever stops first; alone, as many "
+                        "triangles go as the error allows (up to 99.9%%)")
     parser.add_argument("--output", required=True,
                         help="output prefix: writes PREFIX.<format> for each of --formats and "
                         "PREFIX.json")
@@ -106,6 +118,11 @@ def parse_args(argv):
         parser.error("--beside-contour needs --screenshot")
     if args.iterations < 0:
         parser.error("--iterations must be at least 0")
+    if args.decimate is not None and not 0 < args.decimate < 1:
+        parser.error("--decimate takes the fraction of the triangles to remove, greater than 0 "
+                     "and less than 1, not %g" % args.decimate)
+    if args.max_error is not None and not args.max_error > 0:
+        parser.error("--max-error takes a positive distance, not %g" % args.max_error)
     args.formats = [f.strip().lower() for f in args.formats.split(",") if f.strip()]
     for f in args.formats:
         if f not in ("stl", "ply", "vtp"):
@@ -149,6 +166,75 @@ def describe_measures(m):
     if m["border_cap_area"]:
         text += "; closed across the volume's border by %.6g %s" % (m["border_cap_area"], area)
     return text
+
+
+def distances(decimated, original):
+    """The symmetric Hausdorff and mean distances between two surfaces, sampled at each one's
+    vertices (to the other surface), from copies of both on this process (for the report only:
+    the decimation itself gathers nothing)."""
+    from paraview import servermanager
+    from vtkmodules.vtkFiltersGeneral import vtkDistancePolyDataFilter
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    import numpy
+    pieces = [servermanager.Fetch(s) for s in (decimated, original)]
+    surfaces = []
+    for piece in pieces:
+        # A multi-piece fetch comes as one polydata (appended) in a builtin session.
+        if piece.IsA("vtkMultiBlockDataSet"):
+            from vtkmodules.vtkFiltersCore import vtkAppendPolyData
+            append = vtkAppendPolyData()
+            for i in range(piece.GetNumberOfBlocks()):
+                append.AddInputData(piece.GetBlock(i))
+            append.Update()
+            piece = append.GetOutput()
+        surfaces.append(piece)
+    measure = vtkDistancePolyDataFilter()
+    measure.SetInputData(0, surfaces[0])
+    measure.SetInputData(1, surfaces[1])
+    measure.SignedDistanceOff()
+    measure.ComputeSecondDistanceOn()
+    measure.Update()
+    there = numpy.abs(vtk_to_numpy(measure.GetOutput().GetPointData().GetArray("Distance")))
+    back = numpy.abs(vtk_to_numpy(measure.GetSecondDistanceOutput().GetPointData().GetArray("Distance")))
+    return {"hausdorff": float(max(there.max(), back.max())),
+            "mean": float(0.5 * (there.mean() + back.mean()))}
+
+
+def decimate(repaired, args, report):
+    """Decimate Surface after the repair; its triangles, distances and volume change go into
+    the report and the summary."""
+    from paraview import simple
+    reduction = args.decimate if args.decimate is not None else 0.999
+    decimated = simple.RGDecimate(Input=repaired, TargetReduction=reduction,
+                                  MaximumError=args.max_error or 0.0)
+    started = time.time()
+    decimated.UpdatePipeline()
+    seconds = time.time() - started
+    information = decimated.GetDataInformation()
+    fields = information.DataInformation.GetFieldDataInformation()
+    before = report["checks"]["Triangles"]
+    checks = {name: int(fields.GetArrayInformation(name).GetComponentRange(0)[0]) for name in CHECKS}
+    volume_before = report["measures"]["volume"]
+    volume = fields.GetArrayInformation("EnclosedVolume").GetComponentRange(0)[0]
+    entry = {
+        "target_reduction": args.decimate, "max_error": args.max_error, "seconds": round(seconds, 4),
+        "triangles_before": before, "triangles": checks["Triangles"], "checks": checks,
+        "quadric_error": fields.GetArrayInformation("DecimationQuadricError").GetComponentRange(0)[0],
+        "area": fields.GetArrayInformation("SurfaceArea").GetComponentRange(0)[0],
+        "volume": None if volume != volume else volume,
+    }
+    entry["volume_change_percent"] = (
+        100.0 * (volume / volume_before - 1.0) if volume_before and volume == volume else None)
+    entry.update(distances(decimated, repaired))
+    report["decimation"] = entry
+    print("decimated:  %d -> %d triangles (%.1f%% removed) in %.3f s; %s, Euler characteristic %d" % (
+        before, checks["Triangles"], 100.0 * (1 - checks["Triangles"] / before), seconds,
+        "closed" if checks["Closed"] else "not closed", checks["EulerCharacteristic"]))
+    change = entry["volume_change_percent"]
+    print("distance:   Hausdorff %.4g, mean %.4g to the undecimated surface%s" % (
+        entry["hausdorff"], entry["mean"],
+        "; volume changed by %+.3f%%" % change if change is not None else ""))
+    return decimated
 
 
 def new_view(size):
@@ -346,21 +432,25 @@ def main(argv):
     report["measures"] = measures(fields, medical=bool(summary) or args.input.startswith("phantom:"))
     print("measures:   %s" % describe_measures(report["measures"]))
 
+    final = repaired
+    if args.decimate is not None or args.max_error is not None:
+        final = decimate(repaired, args, report)
+
     directory = os.path.dirname(os.path.abspath(args.output))
     os.makedirs(directory, exist_ok=True)
     for extension in args.formats:
         # The plugin's Merged Surface Writer: one mesh, seam vertices merged, from any rank count.
         path = args.output + "." + extension
-        simple.SaveData(path, proxy=repaired, FileType="Binary")
+        simple.SaveData(path, proxy=final, FileType="Binary")
         report["outputs"].append(path)
     if args.screenshot and args.beside_contour:
-        report["contour_triangles"] = render_beside_contour(volume, array, repaired, args)
+        report["contour_triangles"] = render_beside_contour(volume, array, final, args)
         report["outputs"].append(args.screenshot)
         print("contour:    ParaView's Contour at %g gives %d triangles: every surface at that "
               "value (left in the picture), %d of them the structure's" % (
                   args.isovalue, report["contour_triangles"], triangles))
     elif args.screenshot:
-        render(repaired, args, ranks)
+        render(final, args, ranks)
         report["outputs"].append(args.screenshot)
     with open(args.output + ".json", "w") as out:
         json.dump(report, out, indent=2)

@@ -77,7 +77,6 @@ struct Candidate
   double Cost;
   int A, B; // A < B: the order of their global ids
   unsigned StampA, StampB;
-  double Position[3];
 
   // The queue's top is the cheapest, then the lowest (A, B).
   bool operator<(const Candidate& other) const
@@ -98,12 +97,13 @@ struct Candidate
 class EdgeCollapser
 {
 public:
-  EdgeCollapser(const DecimationBlock& block, double maximumError)
+  EdgeCollapser(const DecimationBlock& block, double maximumError, std::size_t maximumCollapses)
     : Points(block.Points)
     , Quadrics(block.Quadrics)
     , Triangles(block.Triangles)
     , Owned(block.Triangles.size())
     , MaximumCost(maximumError > 0.0 ? maximumError * maximumError : -1.0)
+    , MaximumCollapses(maximumCollapses)
   {
     const std::size_t n = block.Ids.size();
     this->Triangles.insert(this->Triangles.end(), block.Halo.begin(), block.Halo.end());
@@ -114,6 +114,14 @@ public:
       {
         this->Star[v].push_back(static_cast<int>(t));
       }
+    }
+    // Each triangle's normal before any collapse: no collapse may turn a triangle against it,
+    // even in steps that each turn it less than a right angle.
+    this->Initial.resize(this->Triangles.size());
+    for (std::size_t t = 0; t < this->Triangles.size(); ++t)
+    {
+      const auto& tri = this->Triangles[t];
+      Cross(this->Point(tri[0]), this->Point(tri[1]), this->Point(tri[2]), this->Initial[t].data());
     }
     this->Stamp.assign(n, 0);
     this->Gone.assign(n, 0);
@@ -128,39 +136,32 @@ public:
   {
     std::vector<Collapse> log;
     double level = 0.0;
-    // Sweeps: a candidate found invalid is dropped; once the queue is empty, every edge is
-    // queued again (some have become valid), until a sweep collapses nothing.
-    for (int sweep = 0; sweep < 4; ++sweep)
+    // A candidate found invalid is dropped: it is queued again only when one of its ends
+    // changes (its cost changes then too).
+    this->QueueAllEdges();
+    while (!this->Queue.empty() && log.size() < this->MaximumCollapses)
     {
-      this->QueueAllEdges();
-      const std::size_t before = log.size();
-      while (!this->Queue.empty())
+      const Candidate c = this->Queue.top();
+      this->Queue.pop();
+      if (this->Gone[c.A] || this->Gone[c.B] || c.StampA != this->Stamp[c.A] ||
+        c.StampB != this->Stamp[c.B])
       {
-        const Candidate c = this->Queue.top();
-        this->Queue.pop();
-        if (this->Gone[c.A] || this->Gone[c.B] || c.StampA != this->Stamp[c.A] ||
-          c.StampB != this->Stamp[c.B])
-        {
-          continue;
-        }
-        if (this->MaximumCost >= 0.0 && c.Cost > this->MaximumCost)
-        {
-          std::priority_queue<Candidate>().swap(this->Queue);
-          break;
-        }
-        if (!this->CanCollapse(c))
-        {
-          continue;
-        }
-        this->CollapseEdge(c);
-        level = std::max(level, c.Cost);
-        log.push_back(Collapse{ c.B, c.A, { c.Position[0], c.Position[1], c.Position[2] }, level });
-        this->QueueEdgesAround(c.A);
+        continue;
       }
-      if (log.size() == before)
+      if (this->MaximumCost >= 0.0 && c.Cost > this->MaximumCost)
       {
         break;
       }
+      double position[3];
+      this->Place(c.A, c.B, position);
+      if (!this->CanCollapse(c.A, c.B, position))
+      {
+        continue;
+      }
+      this->CollapseEdge(c.A, c.B, position);
+      level = std::max(level, c.Cost);
+      log.push_back(Collapse{ c.B, c.A, { position[0], position[1], position[2] }, level });
+      this->QueueEdgesAround(c.A);
     }
     return log;
   }
@@ -171,7 +172,9 @@ private:
   std::vector<std::array<int, 3>> Triangles; // own, then halo
   std::size_t Owned;
   double MaximumCost;
+  std::size_t MaximumCollapses;
   std::vector<std::vector<int>> Star; // the live triangles around each vertex
+  std::vector<std::array<double, 3>> Initial;
   std::vector<unsigned> Stamp;
   std::vector<std::uint8_t> Gone, Movable;
   std::priority_queue<Candidate> Queue;
@@ -243,15 +246,17 @@ private:
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
-  // The best position for the merged vertex of a and b and its error: the quadric's minimum when
-  // well defined and near the edge, else the best of the midpoint and the two ends.
   Candidate Evaluate(int a, int b) const
   {
-    Candidate c;
-    c.A = a;
-    c.B = b;
-    c.StampA = this->Stamp[a];
-    c.StampB = this->Stamp[b];
+    double position[3];
+    return Candidate{ this->Place(a, b, position), a, b, this->Stamp[a], this->Stamp[b] };
+  }
+
+  // The best position for the merged vertex of a and b, and its error: the quadric's minimum
+  // when well defined and near the edge, else the best of the midpoint and the two ends.
+  double Place(int a, int b, double position[3]) const
+  {
+    double cost;
     const Quadric q = this->Quadrics[a] + this->Quadrics[b];
     const auto& m = q.Terms;
     const double* pa = this->Point(a);
@@ -279,28 +284,27 @@ private:
         (x[2] - mid[2]) * (x[2] - mid[2]);
       if (std::isfinite(d2) && d2 <= edge2)
       {
-        std::copy(x, x + 3, c.Position);
-        c.Cost = q.Error(x);
+        std::copy(x, x + 3, position);
+        cost = q.Error(x);
         solved = true;
       }
     }
     if (!solved)
     {
       const double* options[3] = { mid, pa, pb };
-      c.Cost = q.Error(mid);
-      std::copy(mid, mid + 3, c.Position);
+      cost = q.Error(mid);
+      std::copy(mid, mid + 3, position);
       for (int i = 1; i < 3; ++i)
       {
         const double e = q.Error(options[i]);
-        if (e < c.Cost)
+        if (e < cost)
         {
-          c.Cost = e;
-          std::copy(options[i], options[i] + 3, c.Position);
+          cost = e;
+          std::copy(options[i], options[i] + 3, position);
         }
       }
     }
-    c.Cost = std::isfinite(c.Cost) ? std::max(0.0, c.Cost) : HUGE_VAL;
-    return c;
+    return std::isfinite(cost) ? std::max(0.0, cost) : HUGE_VAL;
   }
 
   void QueueAllEdges()
@@ -337,9 +341,8 @@ private:
     }
   }
 
-  bool CanCollapse(const Candidate& c)
+  bool CanCollapse(int a, int b, const double position[3])
   {
-    const int a = c.A, b = c.B;
     // The edge's two triangles and their third corners.
     int opposite[2], shared = 0;
     for (int t : this->Star[a])
@@ -406,13 +409,16 @@ private:
         for (int i = 0; i < 3; ++i)
         {
           p[i] = this->Point(tri[i]);
-          moved[i] = tri[i] == end ? c.Position : p[i];
+          moved[i] = tri[i] == end ? position : p[i];
         }
         double before[3], after[3];
         Cross(p[0], p[1], p[2], before);
         Cross(moved[0], moved[1], moved[2], after);
+        const double* initial = this->Initial[t].data();
         const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
-        if (!(dot > 0.0))
+        const double fromStart =
+          initial[0] * after[0] + initial[1] * after[1] + initial[2] * after[2];
+        if (!(dot > 0.0) || !(fromStart > 0.0))
         {
           return false;
         }
@@ -421,11 +427,10 @@ private:
     return true;
   }
 
-  void CollapseEdge(const Candidate& c)
+  void CollapseEdge(int a, int b, const double position[3])
   {
-    const int a = c.A, b = c.B;
     this->Quadrics[a] = this->Quadrics[a] + this->Quadrics[b];
-    std::copy(c.Position, c.Position + 3, this->Points.begin() + 3 * a);
+    std::copy(position, position + 3, this->Points.begin() + 3 * a);
     auto drop = [this](int v, int t)
     {
       auto& star = this->Star[v];
@@ -508,9 +513,10 @@ void DecimationBlock::ComputeQuadrics()
   }
 }
 
-std::vector<Collapse> Simplify(const DecimationBlock& block, double maximumError)
+std::vector<Collapse> Simplify(
+  const DecimationBlock& block, double maximumError, std::size_t maximumCollapses)
 {
-  return EdgeCollapser(block, maximumError).Run();
+  return EdgeCollapser(block, maximumError, maximumCollapses).Run();
 }
 
 void ApplyCollapses(DecimationBlock& block, const std::vector<Collapse>& log, std::size_t count)

@@ -63,9 +63,11 @@ struct Collapse
 /// Simplifies the block as far as it goes, cheapest collapse first (ties by the global ids of
 /// the edge's ends), and returns the collapses in order. A collapse is made only when it keeps
 /// the surface a manifold of the same topology (the link condition, and no vertex left with
-/// fewer than three neighbours), flips no triangle, and moves no fixed vertex; and, when
-/// `maximumError` is positive, when its quadric error is at most maximumError^2.
-std::vector<Collapse> Simplify(const DecimationBlock& block, double maximumError);
+/// fewer than three neighbours), turns no triangle over (against its normal before the collapse
+/// or before the first), and moves no fixed vertex; and, when `maximumError` is positive, when
+/// its quadric error is at most maximumError^2. Stops after `maximumCollapses`.
+std::vector<Collapse> Simplify(
+  const DecimationBlock& block, double maximumError, std::size_t maximumCollapses);
 
 /// Applies the first `count` collapses of `log` to the block: positions and quadrics of the kept
 /// vertices, and the triangles that remain (in their order); unused vertices are left as they

@@ -1,0 +1,277 @@
+// RGMC's decimation benchmark (not a test; `./rgmc evaluate --decimate` runs it):
+//
+//   mpiexec -n R rgmcDecimateBenchmark [--size 512] [--reduction 0.9] [--threads 1,2]
+//                                      [--repeats 3] [--vtk 1] [--block 20000]
+//
+// The CT phantom's skull (`size`^3, seeded at 400 HU, Seam Repair with 20 Laplacian iterations)
+// reduced by vtkRGDecimate on R ranks at each thread count, and, on one rank when --vtk is 1, by
+// vtkQuadricDecimation and vtkDecimatePro (PreserveTopology on, so that it may not reach the
+// target) on the same merged mesh in the same run. For each: seconds (the slowest rank's, the
+// fastest of `repeats`), triangles, the symmetric Hausdorff and mean distances to the undecimated
+// surface (sampled at the vertices of each surface, to the other surface, in voxels), and whether
+// the output is closed (every edge in exactly two triangles, once each way). Each rank builds
+// only its block of the volume. Prints one JSON object per line on rank 0.
+#include "rgmcBenchmark.h"       // Now, IntList
+#include "rgmcDistributedData.h" // BlockPiece, PhantomPiece, MarkGhostCells
+#include "vtkRGDecimate.h"
+#include "vtkRGMarchingCubes.h"
+#include "vtkRGSeamRepair.h"
+
+#include "vtkCellArray.h"
+#include "vtkDecimatePro.h"
+#include "vtkGenericCell.h"
+#include "vtkIdTypeArray.h"
+#include "vtkImageData.h"
+#include "vtkMPIController.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkQuadricDecimation.h"
+#include "vtkSMPTools.h"
+#include "vtkStaticCellLocator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+
+using rgmc_benchmark::Now;
+
+/// The pieces of a distributed surface numbered as one mesh, merged on rank 0 (for measuring
+/// only): points by global id.
+vtkSmartPointer<vtkPolyData> Merge(vtkMultiProcessController* controller, vtkPolyData* piece)
+{
+  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
+  controller->Gather(piece, pieces, 0);
+  auto merged = vtkSmartPointer<vtkPolyData>::New();
+  if (controller->GetLocalProcessId() != 0)
+  {
+    return merged;
+  }
+  std::map<vtkIdType, std::array<double, 3>> points;
+  std::vector<std::array<vtkIdType, 3>> triangles;
+  for (auto& object : pieces)
+  {
+    vtkPolyData* pd = vtkPolyData::SafeDownCast(object);
+    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
+    {
+      std::array<double, 3> x;
+      pd->GetPoint(p, x.data());
+      points[ids->GetValue(p)] = x;
+    }
+    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
+    {
+      vtkIdType n;
+      const vtkIdType* pts;
+      pd->GetCellPoints(t, n, pts);
+      triangles.push_back({ ids->GetValue(pts[0]), ids->GetValue(pts[1]), ids->GetValue(pts[2]) });
+    }
+  }
+  vtkNew<vtkPoints> xyz;
+  xyz->SetDataTypeToDouble();
+  std::map<vtkIdType, vtkIdType> index;
+  for (const auto& p : points)
+  {
+    index[p.first] = xyz->InsertNextPoint(p.second.data());
+  }
+  vtkNew<vtkCellArray> polys;
+  for (const auto& t : triangles)
+  {
+    const vtkIdType ids[3] = { index[t[0]], index[t[1]], index[t[2]] };
+    polys->InsertNextCell(3, ids);
+  }
+  merged->SetPoints(xyz);
+  merged->SetPolys(polys);
+  return merged;
+}
+
+/// The largest and mean distance from the vertices of `from` to the surface `to`.
+void Distances(vtkPolyData* from, vtkPolyData* to, double& largest, double& mean)
+{
+  vtkNew<vtkStaticCellLocator> locator;
+  locator->SetDataSet(to);
+  locator->BuildLocator();
+  vtkNew<vtkGenericCell> cell;
+  largest = 0;
+  double sum = 0;
+  for (vtkIdType p = 0; p < from->GetNumberOfPoints(); ++p)
+  {
+    double x[3], closest[3], d2;
+    vtkIdType cellId;
+    int subId;
+    from->GetPoint(p, x);
+    locator->FindClosestPoint(x, closest, cell, cellId, subId, d2);
+    largest = std::max(largest, std::sqrt(d2));
+    sum += std::sqrt(d2);
+  }
+  mean = from->GetNumberOfPoints() ? sum / from->GetNumberOfPoints() : 0;
+}
+
+/// Whether every edge is in exactly two triangles, once in each direction.
+bool Closed(vtkPolyData* pd)
+{
+  std::vector<std::pair<vtkIdType, vtkIdType>> directed;
+  for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
+  {
+    vtkIdType n;
+    const vtkIdType* pts;
+    pd->GetCellPoints(t, n, pts);
+    if (n != 3)
+    {
+      return false;
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      directed.emplace_back(pts[k], pts[(k + 1) % 3]);
+    }
+  }
+  std::sort(directed.begin(), directed.end());
+  for (std::size_t e = 0; e < directed.size(); ++e)
+  {
+    if (e > 0 && directed[e] == directed[e - 1])
+    {
+      return false;
+    }
+    const std::pair<vtkIdType, vtkIdType> back{ directed[e].second, directed[e].first };
+    if (!std::binary_search(directed.begin(), directed.end(), back))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// One JSON line for a decimated surface against the original.
+std::string Row(const std::string& method, int ranks, int threads, double seconds,
+  vtkPolyData* original, vtkPolyData* decimated, double voxel)
+{
+  double there, thereMean, back, backMean;
+  Distances(decimated, original, there, thereMean);
+  Distances(original, decimated, back, backMean);
+  std::ostringstream os;
+  os << "{\"method\": \"" << method << "\", \"ranks\": " << ranks << ", \"threads\": " << threads
+     << ", \"seconds\": " << seconds << ", \"triangles_before\": " << original->GetNumberOfCells()
+     << ", \"triangles\": " << decimated->GetNumberOfCells()
+     << ", \"hausdorff_voxels\": " << std::max(there, back) / voxel
+     << ", \"mean_voxels\": " << 0.5 * (thereMean + backMean) / voxel
+     << ", \"closed\": " << (Closed(decimated) ? "true" : "false") << "}";
+  return os.str();
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  vtkNew<vtkMPIController> controller;
+  controller->Initialize(&argc, &argv);
+  vtkMultiProcessController::SetGlobalController(controller);
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  int size = 512, repeats = 3, vtk = 1;
+  long long block = 20000;
+  double reduction = 0.9;
+  std::vector<int> threadCounts = { 1, 2 };
+  for (int a = 1; a + 1 < argc; a += 2)
+  {
+    const std::string option = argv[a], value = argv[a + 1];
+    if (option == "--size")
+    {
+      size = std::atoi(value.c_str());
+    }
+    else if (option == "--repeats")
+    {
+      repeats = std::atoi(value.c_str());
+    }
+    else if (option == "--reduction")
+    {
+      reduction = std::atof(value.c_str());
+    }
+    else if (option == "--threads")
+    {
+      threadCounts = rgmc_benchmark::IntList(value);
+    }
+    else if (option == "--block")
+    {
+      block = std::atoll(value.c_str());
+    }
+    else if (option == "--vtk")
+    {
+      vtk = std::atoi(value.c_str());
+    }
+  }
+
+  // The skull, repaired and smoothed, on every rank's block.
+  const int whole[6] = { 0, size - 1, 0, size - 1, 0, size - 1 };
+  int owned[6], ghosted[6];
+  rgmc_test::BlockPiece(whole, rank, ranks, owned, ghosted);
+  vtkSmartPointer<vtkImageData> piece = rgmc_test::PhantomPiece(ghosted, size);
+  if (ranks > 1)
+  {
+    rgmc_test::MarkGhostCells(piece, owned);
+  }
+  const double voxel = piece->GetSpacing()[0];
+  vtkNew<vtkRGMarchingCubes> extract;
+  extract->SetInputData(piece);
+  extract->SetIsovalue(400);
+  extract->AddSeedPoint(0, 0, 105);
+  vtkNew<vtkRGSeamRepair> repair;
+  repair->SetInputConnection(extract->GetOutputPort());
+  repair->Update();
+  auto repaired = vtkSmartPointer<vtkPolyData>::New();
+  repaired->DeepCopy(repair->GetOutput());
+  vtkSmartPointer<vtkPolyData> original = Merge(controller, repaired);
+
+  vtkNew<vtkRGDecimate> decimate;
+  decimate->SetInputData(repaired);
+  decimate->SetTargetReduction(reduction);
+  decimate->SetTrianglesPerBlock(block);
+  for (int threads : threadCounts)
+  {
+    double best = 1e300;
+    vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+      [&]()
+      {
+        for (int r = 0; r < repeats; ++r)
+        {
+          controller->Barrier();
+          const double start = Now();
+          decimate->Modified();
+          decimate->Update();
+          double mine = Now() - start, slowest = 0;
+          controller->AllReduce(&mine, &slowest, 1, vtkCommunicator::MAX_OP);
+          best = std::min(best, slowest);
+        }
+      });
+    vtkSmartPointer<vtkPolyData> result = Merge(controller, decimate->GetOutput());
+    if (rank == 0)
+    {
+      std::cout << Row("RGDecimate", ranks, threads, best, original, result, voxel) << std::endl;
+    }
+  }
+  if (rank == 0 && ranks == 1 && vtk)
+  {
+    vtkNew<vtkQuadricDecimation> quadric;
+    quadric->SetInputData(original);
+    quadric->SetTargetReduction(reduction);
+    const double quadricSeconds = rgmc_benchmark::FastestUpdate(1, quadric.Get());
+    std::cout << Row("vtkQuadricDecimation", 1, 1, quadricSeconds, original, quadric->GetOutput(),
+                   voxel)
+              << std::endl;
+    vtkNew<vtkDecimatePro> pro;
+    pro->SetInputData(original);
+    pro->SetTargetReduction(reduction);
+    pro->PreserveTopologyOn();
+    const double proSeconds = rgmc_benchmark::FastestUpdate(1, pro.Get());
+    std::cout << Row("vtkDecimatePro", 1, 1, proSeconds, original, pro->GetOutput(), voxel)
+              << std::endl;
+  }
+  controller->Finalize();
+  return 0;
+}
