@@ -194,8 +194,15 @@ def distances(decimated, original):
     measure.SignedDistanceOff()
     measure.ComputeSecondDistanceOn()
     measure.Update()
-    there = numpy.abs(vtk_to_numpy(measure.GetOutput().GetPointData().GetArray("Distance")))
-    back = numpy.abs(vtk_to_numpy(measure.GetSecondDistanceOutput().GetPointData().GetArray("Distance")))
+    def owned(output):
+        # Each vertex once: not the copies that other ranks own (Seam Repair's duplicate flags).
+        data = output.GetPointData()
+        distance = numpy.abs(vtk_to_numpy(data.GetArray("Distance")))
+        ghosts = data.GetArray("vtkGhostType")
+        # Sorted, so that the mean does not depend on the order the ranks' pieces came in.
+        return numpy.sort(distance if ghosts is None else distance[vtk_to_numpy(ghosts) == 0])
+    there = owned(measure.GetOutput())
+    back = owned(measure.GetSecondDistanceOutput())
     return {"hausdorff": float(max(there.max(), back.max())),
             "mean": float(0.5 * (there.mean() + back.mean()))}
 

@@ -115,6 +115,45 @@ def main():
         check(found is not None and abs(float(found.group(1)) - enclosed) <= 1e-5 * enclosed,
               "admesh's volume %s, the report's %s" % (found and found.group(1), enclosed))
 
+    # Decimated to a tenth on 1 and 3 ranks: the same file to the byte (one mesh, in one order),
+    # closed for admesh too, with the report's distances and volume change.
+    decimated = {}
+    for ranks in (1, 3):
+        out = "%s-decimated-%d" % (prefix, ranks)
+        result = run(pipeline + ["--input", volume, "--isovalue", "400", "--seed", "0,0,105",
+                                 "--output", out, "--ranks", str(ranks), "--decimate", "0.9",
+                                 "--formats", "stl,ply"])
+        check(result.returncode == 0, "the decimating pipeline succeeds on %d ranks" % ranks)
+        check("decimated:" in result.stdout and "Hausdorff" in result.stdout,
+              "the summary says what the decimation did")
+        decimated[ranks] = json.load(open(out + ".json"))["decimation"]
+        entry = decimated[ranks]
+        check(abs(entry["triangles"] - 0.1 * entry["triangles_before"]) <= 0.01 * entry["triangles_before"],
+              "a tenth of the triangles kept: %d of %d" % (entry["triangles"], entry["triangles_before"]))
+        check(entry["checks"]["Closed"] == 1 and entry["checks"]["EulerCharacteristic"] == -6,
+              "the decimated skull is closed, Euler characteristic -6: %s" % entry["checks"])
+        check(stl_triangles(out + ".stl") == entry["triangles"], "the decimated STL holds every triangle")
+        check(0 < entry["mean"] < entry["hausdorff"] < 1.0,
+              "distances to the undecimated surface under a voxel (%.4g mm, mean %.4g)" % (
+                  entry["hausdorff"], entry["mean"]))
+        check(entry["volume_change_percent"] is not None and abs(entry["volume_change_percent"]) < 0.5,
+              "the volume changes by less than 0.5%%: %s" % entry["volume_change_percent"])
+        if args.admesh:
+            text = run([args.admesh, out + ".stl"]).stdout
+            for line in ("Facets with 1 disconnected edge", "Facets with 2 disconnected edges",
+                         "Facets with 3 disconnected edges"):
+                check(re.search(line + r"\s*:\s*0\s", text) is not None,
+                      "admesh, decimated on %d ranks: %s is not 0" % (ranks, line))
+            check(re.search(r"Number of parts\s*:\s*1\s", text) is not None,
+                  "admesh, decimated on %d ranks: one part" % ranks)
+    for extension in ("stl", "ply"):
+        same = open("%s-decimated-1.%s" % (prefix, extension), "rb").read() == \
+            open("%s-decimated-3.%s" % (prefix, extension), "rb").read()
+        check(same, "the decimated %s is the same file on 1 and 3 ranks" % extension.upper())
+    for key in ("checks", "triangles", "area", "volume", "hausdorff", "mean"):
+        check(decimated[1][key] == decimated[3][key], "1 and 3 ranks: the same %s (%s, %s)" % (
+            key, decimated[1][key], decimated[3][key]))
+
     # Bad input: clear messages and a non-zero exit, nothing written.
     cases = [
         (["--input", "/no/such/file.vti", "--isovalue", "1", "--seed", "0,0,0"], "no such file"),
@@ -123,6 +162,10 @@ def main():
         (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--array", "nope"], "no point array"),
         (["--input", volume, "--isovalue", "9000", "--seed", "0,0,105"], "outside the data range"),
         (["--input", volume, "--isovalue", "400", "--seed", "0,0,900"], "lies outside the volume"),
+        (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--decimate", "1"],
+         "--decimate takes the fraction"),
+        (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--max-error", "-1"],
+         "--max-error takes a positive distance"),
     ]
     for extra, message in cases:
         result = run(pipeline + extra + ["--output", os.path.join(args.workdir, "bad")])
