@@ -581,6 +581,71 @@ def ranks_report(rows, args):
     return "\n".join(lines) + "\n"
 
 
+def run_decimate(args):
+    rows = []
+    for ranks in (1, 2):
+        # Threads need cores: Open MPI binds a rank to one core when it has few ranks.
+        command = rgmc_common.mpiexec_command(ranks)
+        if "--map-by" in command:
+            command += ["--bind-to", "none"]
+        command += [args.decimate_binary, "--size", str(args.decimate_size), "--reduction",
+                    str(args.decimate_reduction), "--threads", "1,2" if ranks == 1 else "1",
+                    "--repeats", str(args.decimate_repeats), "--vtk", "1" if ranks == 1 else "0"]
+        print("+ " + " ".join(command), flush=True)
+        process = subprocess.run(command, stdout=subprocess.PIPE, text=True,
+                                 env=rgmc_common.mpi_environment())
+        if process.returncode != 0:
+            raise rgmc_common.UsageError("rgmcDecimateBenchmark on %d ranks failed (exit %d)" % (
+                ranks, process.returncode))
+        for line in process.stdout.splitlines():
+            if line.startswith("{"):
+                rows.append(json.loads(line))
+                print("  " + line, flush=True)
+    return rows
+
+
+def decimate_report(rows, args):
+    lines = report_header("# RGMC decimation benchmark") + [
+             "The CT phantom's skull (%d^3, seeded at 400 HU, Seam Repair with 20 Laplacian "
+             "iterations) reduced by %g. Decimate Surface (vtkRGDecimate) on 1 and 2 ranks and 1 and "
+             "2 threads; vtkQuadricDecimation and vtkDecimatePro (PreserveTopology on) on the merged "
+             "mesh on one rank, in the same run. Seconds: the slowest rank's, minimum of %d runs "
+             "(VTK's filters: one run). Distances: sampled at each surface's vertices to the other "
+             "surface, in voxels; closed: every edge in exactly two triangles, once each way." % (
+                 args.decimate_size, args.decimate_reduction, args.decimate_repeats), "",
+             "| method | ranks | threads | seconds | triangles | Hausdorff (voxels) | mean (voxels) "
+             "| closed |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append("| %s | %d | %d | %.3f | %d of %d | %.4f | %.5f | %s |" % (
+            r["method"], r["ranks"], r["threads"], r["seconds"], r["triangles"],
+            r["triangles_before"], r["hausdorff_voxels"], r["mean_voxels"],
+            "yes" if r["closed"] else "no"))
+
+    def find_row(method, ranks, threads):
+        found = [r for r in rows if r["method"] == method and r["ranks"] == ranks and r["threads"] == threads]
+        return found[0] if found else None
+    ours, quadric = find_row("RGDecimate", 1, 1), find_row("vtkQuadricDecimation", 1, 1)
+    lines += ["", "Targets (issue 24), met or not:", ""]
+    if ours and quadric:
+        ratio = quadric["seconds"] / ours["seconds"]
+        lines.append("- >= 5x faster than vtkQuadricDecimation on one thread: %.1fx, %s" % (
+            ratio, "met" if ratio >= 5 else "NOT met"))
+        for key, name in (("hausdorff_voxels", "Hausdorff"), ("mean_voxels", "mean")):
+            lines.append("- %s distance <= vtkQuadricDecimation's: %.4f vs %.4f, %s" % (
+                name, ours[key], quadric[key], "met" if ours[key] <= quadric[key] else "NOT met"))
+    for ranks, threads in ((1, 2), (2, 1)):
+        other = find_row("RGDecimate", ranks, threads)
+        if ours and other:
+            ratio = ours["seconds"] / other["seconds"]
+            lines.append("- >= 1.7x from 2 %s: %.2fx, %s" % (
+                "threads" if threads == 2 else "ranks", ratio, "met" if ratio >= 1.7 else "NOT met"))
+    same = len({(r["triangles"], r["hausdorff_voxels"], r["mean_voxels"]) for r in rows
+                if r["method"] == "RGDecimate"}) == 1
+    lines.append("- the same surface on every rank and thread count (triangles and distances): %s" % (
+        "yes" if same else "NO"))
+    return "\n".join(lines) + "\n"
+
+
 def write_results(folder, name, results, text):
     """Writes <name>.json and <name>.md (the report `text`) into `folder` and prints the report."""
     os.makedirs(folder, exist_ok=True)
@@ -632,6 +697,12 @@ def main(argv):
     parser.add_argument("--ranks-phantom", type=int, default=512, help="the phantom's points per axis (0: none)")
     parser.add_argument("--ranks-repeats", type=int, default=4)
     parser.add_argument("--ranks-binary", default=os.path.join(build, "bin", "rgmcRanks"))
+    parser.add_argument("--decimate", action="store_true",
+                        help="the decimation benchmark: Decimate Surface against vtkQuadricDecimation and vtkDecimatePro")
+    parser.add_argument("--decimate-size", type=int, default=512, help="the phantom's points per axis (--decimate)")
+    parser.add_argument("--decimate-reduction", type=float, default=0.9)
+    parser.add_argument("--decimate-repeats", type=int, default=3)
+    parser.add_argument("--decimate-binary", default=os.path.join(build, "bin", "rgmcDecimateBenchmark"))
     parser.add_argument("--report-only", action="store_true",
                         help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)
@@ -647,6 +718,11 @@ def main(argv):
             raise rgmc_common.UsageError("no kernel program at %s: build first (./rgmc build)" % args.kernel_binary)
         result = run_kernel(args)
         return write_results(args.output, "kernel", result, kernel_report(result, args))
+    if args.decimate:
+        if not os.path.isfile(args.decimate_binary):
+            raise rgmc_common.UsageError("no decimation program at %s: build first (./rgmc build)" % args.decimate_binary)
+        rows = run_decimate(args)
+        return write_results(args.output, "decimate", rows, decimate_report(rows, args))
     if args.ranks_benchmark:
         if not os.path.isfile(args.ranks_binary):
             raise rgmc_common.UsageError("no ranks program at %s: build first (./rgmc build)" % args.ranks_binary)
