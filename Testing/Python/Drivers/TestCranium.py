@@ -140,6 +140,22 @@ def main():
         check(len(holder) == 2 and all(piece["distance_to_seeded"] > 10.0 for piece in holder),
               "%d ranks: the head holder is two tall pieces, each over 10 mm from the seeded "
               "skull: %s" % (ranks, holder))
+        small = seeded["decimated"]
+        before = small["input"]
+        check(abs(small["Triangles"] - 0.1 * before["Triangles"]) <= 0.01 * before["Triangles"]
+              and small["TrianglesBeforeDecimation"] == before["Triangles"],
+              "%d ranks: the decimated skull keeps a tenth of %d triangles: %d" % (
+                  ranks, before["Triangles"], small["Triangles"]))
+        check(small["BoundaryEdges"] == 0 and small["NonManifoldEdges"] == 0 and
+              small["VolumeBorderEdges"] == before["VolumeBorderEdges"] and
+              small["EulerCharacteristic"] == before["EulerCharacteristic"],
+              "%d ranks: the decimated skull is closed but at the border, which is unchanged, "
+              "with the same Euler characteristic: %s, before %s" % (ranks, small, before))
+        check(abs(small["EnclosedVolume"] / seeded["measures"]["EnclosedVolume"] - 1) < 0.005,
+              "%d ranks: decimation changes the skull's volume by less than 0.5%%: %s, before %s" % (
+                  ranks, small["EnclosedVolume"], seeded["measures"]["EnclosedVolume"]))
+        check(small == reports[min(reports)]["seeded"]["decimated"],
+              "%d ranks: the decimated skull as on %d ranks" % (ranks, min(reports)))
         first = reports[min(reports)]["seeded"]["measures"]
         check(seeded["measures"] == first, "%d ranks: the skull's measures %s, on %d: %s" % (
             ranks, seeded["measures"], min(reports), first))

@@ -5,7 +5,8 @@ import sys
 
 from paraview import simple
 
-missing = [name for name in ("RGMarchingCubes", "RegionGrowingMarchingCubes", "SeamRepair", "CTPhantom")
+missing = [name for name in ("RGMarchingCubes", "RegionGrowingMarchingCubes", "SeamRepair", "CTPhantom",
+                             "DecimateSurface", "RGDecimate")
            if not hasattr(simple, name)]
 if missing:
     print("FAILED: not auto-loaded: %s" % ", ".join(missing))
@@ -15,5 +16,8 @@ skull = simple.RGMarchingCubes(Input=phantom, ContourBy=["POINTS", "HU"], Isoval
 repaired = simple.SeamRepair(Input=skull)
 repaired.UpdatePipeline()
 triangles = repaired.GetDataInformation().GetNumberOfCells()
-print("installed plugin: %d triangles" % triangles)
-sys.exit(0 if triangles > 0 else 1)
+decimated = simple.DecimateSurface(Input=repaired, TargetReduction=0.5)
+decimated.UpdatePipeline()
+kept = decimated.GetDataInformation().GetNumberOfCells()
+print("installed plugin: %d triangles, %d decimated" % (triangles, kept))
+sys.exit(0 if triangles > 0 and abs(kept - triangles / 2) <= 0.01 * triangles else 1)
