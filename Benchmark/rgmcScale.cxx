@@ -1,8 +1,9 @@
 // RGMC's scale benchmark (not a test; `./rgmc evaluate --scale` runs it): one large surface
-// through the whole job, extract -> seam repair -> Laplacian smoothing -> STL and PLY, with the
-// seconds of each stage and the peak memory of each rank.
+// through the whole job, extract -> seam repair -> Laplacian smoothing [-> decimation] -> STL and
+// PLY, with the seconds of each stage and the peak memory of each rank.
 //
 //   mpiexec -n 2 rgmcScale --size 512 --period 24 --iterations 5 --output /var/tmp/rgmc-scale
+//                          [--decimate 0.9]
 //
 // The volume is a gyroid, sin x cos y + sin y cos z + sin z cos x = 0 with `period` voxels per
 // cell: one connected surface through the whole volume, crossing every partition plane many
@@ -15,6 +16,7 @@
 // stage; the stage's figure is the largest over ranks. Prints one JSON object per line on rank 0.
 #include "rgmcBenchmark.h"       // Now, StatusMiB
 #include "rgmcDistributedData.h" // GyroidPiece
+#include "vtkRGDecimate.h"
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGMergedSurfaceWriter.h"
 #include "vtkRGSeamRepair.h"
@@ -44,6 +46,7 @@ struct Options
   int Size = 512;
   double Period = 24;
   int Iterations = 5;
+  double Decimate = 0; // the fraction of the triangles to remove, 0: no decimation
   std::string Output = "/var/tmp/rgmc-scale";
   bool Keep = false;
 };
@@ -101,6 +104,10 @@ int main(int argc, char* argv[])
     {
       opt.Iterations = std::atoi(argv[++a]);
     }
+    else if (arg == "--decimate" && value)
+    {
+      opt.Decimate = std::atof(argv[++a]);
+    }
     else if (arg == "--output" && value)
     {
       opt.Output = argv[++a];
@@ -119,7 +126,7 @@ int main(int argc, char* argv[])
     if (rank == 0)
     {
       std::cerr << "usage: rgmcScale [--size N] [--period VOXELS] [--iterations N] "
-                   "[--output PREFIX] [--keep]\n";
+                   "[--decimate FRACTION] [--output PREFIX] [--keep]\n";
     }
     controller->Finalize();
     return 2;
@@ -181,6 +188,19 @@ int main(int argc, char* argv[])
   surface->ShallowCopy(repair->GetOutput());
   repair->SetInputData(nullptr);
   extract->GetOutput()->Initialize();
+  long long written = triangles;
+  if (opt.Decimate > 0)
+  {
+    vtkNew<vtkRGDecimate> decimate;
+    decimate->SetInputData(surface);
+    decimate->SetTargetReduction(opt.Decimate);
+    controller->Barrier();
+    t0 = Now();
+    decimate->Update();
+    written = decimate->GetOutput()->GetNumberOfPolys();
+    Report(controller, "decimate", Now() - t0, written);
+    surface->ShallowCopy(decimate->GetOutput());
+  }
 
   for (const char* format : { "stl", "ply" })
   {
@@ -191,7 +211,7 @@ int main(int argc, char* argv[])
     controller->Barrier();
     t0 = Now();
     const int ok = writer->Write();
-    Report(controller, (std::string("write ") + format).c_str(), Now() - t0, triangles);
+    Report(controller, (std::string("write ") + format).c_str(), Now() - t0, written);
     if (!ok)
     {
       controller->Finalize();

@@ -347,6 +347,8 @@ def run_scale(args):
         command = rgmc_common.mpiexec_command(ranks) + [
             args.scale_binary, "--size", str(args.scale_size), "--period", str(args.scale_period),
             "--iterations", "5", "--output", os.path.join(args.output, "scale-surface")]
+        if args.scale_decimate:
+            command += ["--decimate", str(args.scale_decimate)]
         print("+ " + " ".join(command), flush=True)
         process = subprocess.run(command, stdout=subprocess.PIPE, text=True,
                                  env=rgmc_common.mpi_environment())
@@ -361,16 +363,17 @@ def run_scale(args):
 
 
 def scale_report(rows, args):
-    stages = ["extract", "repair", "smooth", "write stl", "write ply"]
+    stages = ["extract", "repair", "smooth", "decimate", "write stl", "write ply"]
     counts = sorted({r["ranks"] for r in rows})
     at = {(r["stage"], r["ranks"]): r for r in rows}
     triangles = max(r["triangles"] for r in rows)
     lines = report_header("# RGMC scale benchmark") + [
              "A %d^3 float gyroid (period %g voxels): %d triangles, one surface through every "
              "partition plane. Extraction (all components, with normals) -> Seam Repair -> 5 Laplacian "
-             "iterations -> merged STL, then PLY, written by every rank into one file. Seconds are the "
+             "iterations%s -> merged STL, then PLY, written by every rank into one file. Seconds are the "
              "slowest rank's; peak memory is each rank's resident-set high-water mark after the stage."
-             % (args.scale_size, args.scale_period, triangles), "",
+             % (args.scale_size, args.scale_period, triangles,
+                " -> Decimate Surface to %g%%" % (100 * (1 - args.scale_decimate)) if args.scale_decimate else ""), "",
              "| stage | " + " | ".join("%d rank%s (s)" % (n, "s" if n > 1 else "") for n in counts) + " |",
              "|---|" + "---|" * len(counts)]
     for stage in stages:
@@ -378,6 +381,12 @@ def scale_report(rows, args):
             "%.2f" % at[(stage, n)]["seconds"] if (stage, n) in at else "-" for n in counts)))
     totals = {n: sum(at[(s, n)]["seconds"] for s in stages if (s, n) in at) for n in counts}
     lines.append("| **whole job** | %s |" % " | ".join("**%.2f**" % totals[n] for n in counts))
+    if any(r["stage"] == "decimate" for r in rows):
+        lines += ["", "Peak memory per rank (MiB) after the smoothing, then after the decimation: " + "; ".join(
+            "%d rank%s: %s, then %s" % (n, "s" if n > 1 else "",
+                                       ", ".join("%.0f" % m for m in at[("smooth", n)]["peak_rss_mib"]),
+                                       ", ".join("%.0f" % m for m in at[("decimate", n)]["peak_rss_mib"]))
+            for n in counts if ("decimate", n) in at and ("smooth", n) in at)]
     lines += ["", "Peak memory per rank (MiB): " + "; ".join(
         "%d rank%s: %s" % (n, "s" if n > 1 else "", ", ".join("%.0f" % m for m in at[("write ply", n)]["peak_rss_mib"]))
         for n in counts if ("write ply", n) in at), ""]
@@ -676,6 +685,8 @@ def main(argv):
                         help="the scale benchmark instead (rgmcScale on --ranks, default 1,2)")
     parser.add_argument("--scale-size", type=int, default=512, help="the gyroid's points per axis")
     parser.add_argument("--scale-period", type=float, default=24, help="the gyroid's period in voxels")
+    parser.add_argument("--scale-decimate", type=float, default=0,
+                        help="--scale: also decimate the surface by this fraction before writing it")
     parser.add_argument("--scale-binary", default=os.path.join(build, "bin", "rgmcScale"))
     parser.add_argument("--threads", action="store_true",
                         help="the threads benchmark instead (rgmcThreadsBenchmark, one rank)")
