@@ -62,80 +62,10 @@ constexpr int MaximumBlocksPerAxis = 32;
 constexpr double PassOffsets[] = { 0.0, 0.5, 0.25, 0.75, 0.125, 0.625 };
 constexpr int Passes = 6;
 
-/// A vertex as it travels: global id, position and, once there is one, quadric.
-struct Vertex
-{
-  vtkIdType Id;
-  double Point[3];
-  rgmc::Quadric Quadric;
-
-  /// Message words of a vertex: id and position, then the quadric's 10 terms when it has one.
-  static std::size_t Words(bool quadric) { return quadric ? 14 : 4; }
-  void Write(std::vector<vtkIdType>& words, bool quadric) const
-  {
-    words.push_back(this->Id);
-    for (double x : this->Point)
-    {
-      words.push_back(rgmc::WordOf(x));
-    }
-    for (std::size_t i = 0; quadric && i < this->Quadric.Terms.size(); ++i)
-    {
-      words.push_back(rgmc::WordOf(this->Quadric.Terms[i]));
-    }
-  }
-  static Vertex Read(const vtkIdType* words, bool quadric)
-  {
-    Vertex v;
-    v.Id = words[0];
-    for (int i = 0; i < 3; ++i)
-    {
-      v.Point[i] = rgmc::RealOf(words[1 + i]);
-    }
-    for (int i = 0; quadric && i < 10; ++i)
-    {
-      v.Quadric.Terms[i] = rgmc::RealOf(words[4 + i]);
-    }
-    return v;
-  }
-};
-
 /// A global id as a radix-sort key, in the ids' signed order.
 std::uint64_t KeyOf(vtkIdType id)
 {
   return static_cast<std::uint64_t>(id) ^ (std::uint64_t(1) << 63);
-}
-
-/// Sorts records by id and keeps one of each (copies of a vertex are equal). The records are
-/// large: their ids and places are sorted, then the records moved once.
-void SortUnique(std::vector<Vertex>& vertices, std::size_t sortedPrefix = 0)
-{
-  auto byId = [](const Vertex& a, const Vertex& b) { return a.Id < b.Id; };
-  auto sameId = [](const Vertex& a, const Vertex& b) { return a.Id == b.Id; };
-  // Mostly in order already (what came from one rank, or a sorted part and a few more): merge.
-  const auto tail = vertices.begin() + static_cast<std::ptrdiff_t>(sortedPrefix);
-  if (std::is_sorted(tail, vertices.end(), byId) || vertices.size() - sortedPrefix < 4096)
-  {
-    std::sort(tail, vertices.end(), byId);
-    std::inplace_merge(vertices.begin(), tail, vertices.end(), byId);
-    vertices.erase(std::unique(vertices.begin(), vertices.end(), sameId), vertices.end());
-    return;
-  }
-  std::vector<std::pair<vtkIdType, std::size_t>> order(vertices.size());
-  for (std::size_t i = 0; i < order.size(); ++i)
-  {
-    order[i] = { vertices[i].Id, i };
-  }
-  rgmc::RadixSort(order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); });
-  std::vector<Vertex> sorted;
-  sorted.reserve(order.size());
-  for (std::size_t i = 0; i < order.size(); ++i)
-  {
-    if (i == 0 || order[i].first != order[i - 1].first)
-    {
-      sorted.push_back(vertices[order[i].second]);
-    }
-  }
-  vertices.swap(sorted);
 }
 
 /// Sorted distinct ids.
@@ -146,12 +76,122 @@ void SortDistinct(std::vector<Id>& ids)
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
 }
 
-const Vertex* Find(const std::vector<Vertex>& vertices, vtkIdType id)
+/// A vertex's global id and position.
+struct Vertex
 {
-  auto at = std::lower_bound(vertices.begin(), vertices.end(), id,
-    [](const Vertex& v, vtkIdType key) { return v.Id < key; });
-  return at != vertices.end() && at->Id == id ? &*at : nullptr;
-}
+  vtkIdType Id;
+  double Point[3];
+};
+
+/// Vertices as they travel between passes: ids and positions and, from the second pass on, their
+/// quadrics, kept apart (before the first pass has summed them there are none to carry, and the
+/// records are then a quarter of the size).
+class VertexTable
+{
+public:
+  std::vector<Vertex> Vertices; // by increasing id once sorted
+  std::vector<rgmc::Quadric> Quadrics;
+  bool HasQuadrics = false;
+
+  std::size_t Words() const { return this->HasQuadrics ? 14 : 4; }
+
+  /// Message words of vertex `i`: id and position, then the quadric's 10 terms.
+  void Write(std::size_t i, std::vector<vtkIdType>& words) const
+  {
+    const Vertex& v = this->Vertices[i];
+    words.push_back(v.Id);
+    for (double x : v.Point)
+    {
+      words.push_back(rgmc::WordOf(x));
+    }
+    for (std::size_t k = 0; this->HasQuadrics && k < 10; ++k)
+    {
+      words.push_back(rgmc::WordOf(this->Quadrics[i].Terms[k]));
+    }
+  }
+
+  void Read(const vtkIdType* words)
+  {
+    Vertex v;
+    v.Id = words[0];
+    for (int k = 0; k < 3; ++k)
+    {
+      v.Point[k] = rgmc::RealOf(words[1 + k]);
+    }
+    this->Vertices.push_back(v);
+    if (this->HasQuadrics)
+    {
+      rgmc::Quadric q;
+      for (int k = 0; k < 10; ++k)
+      {
+        q.Terms[k] = rgmc::RealOf(words[4 + k]);
+      }
+      this->Quadrics.push_back(q);
+    }
+  }
+
+  void Add(const Vertex& v, const rgmc::Quadric* q)
+  {
+    this->Vertices.push_back(v);
+    if (this->HasQuadrics)
+    {
+      this->Quadrics.push_back(*q);
+    }
+  }
+
+  /// The place of vertex `id`, or -1.
+  std::ptrdiff_t Find(vtkIdType id) const
+  {
+    auto at = std::lower_bound(this->Vertices.begin(), this->Vertices.end(), id,
+      [](const Vertex& v, vtkIdType key) { return v.Id < key; });
+    return at != this->Vertices.end() && at->Id == id ? at - this->Vertices.begin() : -1;
+  }
+
+  /// Sorts by id and keeps one of each (copies of a vertex are equal). The first `sortedPrefix`
+  /// are sorted already; when the rest is too (what came from one rank), the two are merged.
+  void SortUnique(std::size_t sortedPrefix = 0)
+  {
+    const std::size_t n = this->Vertices.size();
+    std::vector<std::pair<vtkIdType, std::size_t>> order(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      order[i] = { this->Vertices[i].Id, i };
+    }
+    const auto tail = order.begin() + static_cast<std::ptrdiff_t>(sortedPrefix);
+    if (std::is_sorted(tail, order.end()))
+    {
+      std::inplace_merge(order.begin(), tail, order.end());
+    }
+    else
+    {
+      rgmc::RadixSort(
+        order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); });
+    }
+    std::vector<Vertex> vertices;
+    std::vector<rgmc::Quadric> quadrics;
+    vertices.reserve(n);
+    quadrics.reserve(this->HasQuadrics ? n : 0);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (i == 0 || order[i].first != order[i - 1].first)
+      {
+        vertices.push_back(this->Vertices[order[i].second]);
+        if (this->HasQuadrics)
+        {
+          quadrics.push_back(this->Quadrics[order[i].second]);
+        }
+      }
+    }
+    this->Vertices.swap(vertices);
+    this->Quadrics.swap(quadrics);
+  }
+
+  void Clear()
+  {
+    std::vector<Vertex>().swap(this->Vertices);
+    std::vector<rgmc::Quadric>().swap(this->Quadrics);
+  }
+};
 
 /// The blocks: cubes of edge Size from Origin, shifted by Offset blocks.
 struct Grid
@@ -223,14 +263,14 @@ struct vtkRGDecimate::Run
   // This rank's part of the surface between passes: triangles by global ids (in their cyclic
   // order) and their vertices.
   std::vector<Triangle> surface;
-  std::vector<Vertex> vertices;
+  VertexTable vertices;
   bool quadrics = false; // whether the vertices carry their quadrics yet
   Grid grid;
   std::vector<vtkIdType> blockTriangles; // per block of the grid, over all ranks
   std::vector<int> owner;                // per block
   std::vector<vtkIdType> surfaceBlock;   // the block of each of this rank's triangles
   std::vector<Block> blocks;             // this rank's, by increasing id
-  std::vector<Vertex> seen;              // the vertices of its blocks' triangles and halos
+  VertexTable seen;                      // the vertices of its blocks' triangles and halos
   vtkIdType collapses = 0;               // made in the last pass, over all ranks
   int passes = 0;
   double maximumLevel = 0; // the largest quadric error kept, over all ranks
@@ -397,17 +437,17 @@ bool vtkRGDecimate::ReadSurface(Run& run)
               Vertex v;
               v.Id = ids->GetValue(p);
               input->GetPoint(p, v.Point);
-              run.vertices.push_back(v);
+              run.vertices.Add(v, nullptr);
             }
           }
-          SortUnique(run.vertices);
+          run.vertices.SortUnique();
         }))
   {
     return false;
   }
   double mine[6] = { VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX,
     VTK_DOUBLE_MAX };
-  for (const Vertex& v : run.vertices)
+  for (const Vertex& v : run.vertices.Vertices)
   {
     for (int a = 0; a < 3; ++a)
     {
@@ -467,7 +507,8 @@ bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
           {
             const Triangle& tri = run.surface[t];
             const vtkIdType lowest = std::min({ tri[0], tri[1], tri[2] });
-            run.surfaceBlock[t] = grid.BlockOf(Find(run.vertices, lowest)->Point);
+            run.surfaceBlock[t] =
+              grid.BlockOf(run.vertices.Vertices[run.vertices.Find(lowest)].Point);
             ++mine[run.surfaceBlock[t]];
           }
           run.blockTriangles.assign(mine.size(), 0);
@@ -527,12 +568,12 @@ bool vtkRGDecimate::SendTriangles(Run& run)
             SortDistinct(ids);
             for (vtkIdType id : ids)
             {
-              Find(run.vertices, id)->Write(words, run.quadrics);
+              run.vertices.Write(run.vertices.Find(id), words);
             }
           }
           std::vector<Triangle>().swap(run.surface);
           std::vector<vtkIdType>().swap(run.surfaceBlock);
-          std::vector<Vertex>().swap(run.vertices);
+          run.vertices.Clear();
         }))
   {
     return false;
@@ -542,7 +583,8 @@ bool vtkRGDecimate::SendTriangles(Run& run)
   return run.ranks.Step("receive the blocks' triangles", run.problem,
     [&]()
     {
-      run.seen.clear();
+      run.seen.Clear();
+      run.seen.HasQuadrics = run.quadrics;
       for (const auto& words : incoming)
       {
         if (words.empty())
@@ -560,10 +602,10 @@ bool vtkRGDecimate::SendTriangles(Run& run)
           }
           block->Own.push_back({ words[at + 1], words[at + 2], words[at + 3] });
         }
-        const std::size_t size = Vertex::Words(run.quadrics);
+        const std::size_t size = run.seen.Words();
         for (; at + size <= words.size(); at += size)
         {
-          run.seen.push_back(Vertex::Read(words.data() + at, run.quadrics));
+          run.seen.Read(words.data() + at);
         }
       }
     });
@@ -665,7 +707,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
 {
   const int size = run.ranks.Size;
   std::vector<std::vector<vtkIdType>> outgoing(static_cast<std::size_t>(size));
-  SortUnique(run.seen);
+  run.seen.SortUnique();
   if (!run.ranks.Step("send the halos", run.problem,
         [&]()
         {
@@ -715,7 +757,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
             SortDistinct(ids);
             for (vtkIdType id : ids)
             {
-              Find(run.seen, id)->Write(words, run.quadrics);
+              run.seen.Write(run.seen.Find(id), words);
             }
           }
         }))
@@ -723,7 +765,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
     return false;
   }
   const auto incoming = run.ranks.Exchange(outgoing, Everyone(size), HaloTag);
-  const std::size_t seenBefore = run.seen.size();
+  const std::size_t seenBefore = run.seen.Vertices.size();
   outgoing.clear();
   return run.ranks.Step("assemble the blocks", run.problem,
     [&]()
@@ -745,13 +787,13 @@ bool vtkRGDecimate::SendHalos(Run& run)
           }
           block->Halo.push_back({ words[at + 1], words[at + 2], words[at + 3] });
         }
-        const std::size_t size = Vertex::Words(run.quadrics);
+        const std::size_t size = run.seen.Words();
         for (; at + size <= words.size(); at += size)
         {
-          run.seen.push_back(Vertex::Read(words.data() + at, run.quadrics));
+          run.seen.Read(words.data() + at);
         }
       }
-      SortUnique(run.seen, seenBefore);
+      run.seen.SortUnique(seenBefore);
       rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
         [&](vtkIdType first, vtkIdType last)
         {
@@ -773,9 +815,13 @@ bool vtkRGDecimate::SendHalos(Run& run)
             mesh.Fixed.assign(n, 0);
             for (std::size_t v = 0; v < n; ++v)
             {
-              const Vertex* record = Find(run.seen, mesh.Ids[v]);
-              std::copy(record->Point, record->Point + 3, mesh.Points.begin() + 3 * v);
-              mesh.Quadrics[v] = record->Quadric;
+              const std::ptrdiff_t at = run.seen.Find(mesh.Ids[v]);
+              const Vertex& record = run.seen.Vertices[at];
+              std::copy(record.Point, record.Point + 3, mesh.Points.begin() + 3 * v);
+              if (run.seen.HasQuadrics)
+              {
+                mesh.Quadrics[v] = run.seen.Quadrics[at];
+              }
             }
             auto local = [&mesh](vtkIdType id)
             {
@@ -803,7 +849,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
             }
           }
         });
-      std::vector<Vertex>().swap(run.seen);
+      run.seen.Clear();
     });
 }
 
@@ -943,6 +989,8 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
   if (!ranks.Step("apply the collapses", run.problem,
         [&]()
         {
+          run.vertices.Clear();
+          run.vertices.HasQuadrics = true;
           for (Block& block : run.blocks)
           {
             rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
@@ -965,13 +1013,12 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
                 Vertex record;
                 record.Id = mesh.Ids[v];
                 std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, record.Point);
-                record.Quadric = mesh.Quadrics[v];
-                run.vertices.push_back(record);
+                run.vertices.Add(record, &mesh.Quadrics[v]);
               }
             }
             block = Block{ block.Id, {}, {}, {}, {}, {}, 0 };
           }
-          SortUnique(run.vertices);
+          run.vertices.SortUnique();
           run.blocks.clear();
           run.quadrics = true;
         }))
@@ -1004,15 +1051,15 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
           {
             points->SetDataType(run.input->GetPoints()->GetDataType());
           }
-          const vtkIdType n = static_cast<vtkIdType>(run.vertices.size());
+          const vtkIdType n = static_cast<vtkIdType>(run.vertices.Vertices.size());
           points->SetNumberOfPoints(n);
           vtkNew<vtkIdTypeArray> ids;
           ids->SetName("DecimatedVertexIds");
           rgmc::Allocate(ids.Get(), n);
           for (vtkIdType v = 0; v < n; ++v)
           {
-            points->SetPoint(v, run.vertices[v].Point);
-            ids->SetValue(v, run.vertices[v].Id);
+            points->SetPoint(v, run.vertices.Vertices[v].Point);
+            ids->SetValue(v, run.vertices.Vertices[v].Id);
           }
           vtkNew<vtkIdTypeArray> connectivity, offsets;
           const vtkIdType t = static_cast<vtkIdType>(run.surface.size());
@@ -1024,9 +1071,7 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
             for (int k = 0; k < 3; ++k)
             {
               const vtkIdType id = run.surface[i][k];
-              c[3 * i + k] = std::lower_bound(run.vertices.begin(), run.vertices.end(), id,
-                               [](const Vertex& v, vtkIdType key) { return v.Id < key; }) -
-                run.vertices.begin();
+              c[3 * i + k] = run.vertices.Find(id);
             }
           }
           o[t] = 3 * t;
@@ -1037,7 +1082,7 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
           piece->GetPointData()->SetGlobalIds(ids);
           piece->GetFieldData()->PassData(run.input->GetFieldData());
           std::vector<Triangle>().swap(run.surface);
-          std::vector<Vertex>().swap(run.vertices);
+          run.vertices.Clear();
         }))
   {
     return false;
