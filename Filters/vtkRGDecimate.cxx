@@ -288,16 +288,19 @@ struct vtkRGDecimate::Run
 // collective calls ("exchange" is Ranks::Exchange with every rank).
 //
 //  PASS 0 CheckInput          agreement (properties, triangles, ids, finite points)
-//  PASS 1 ReadSurface         agreement (memory), AllReduce (bounds and triangle count)
-//  then, for each of up to three passes while the target is not reached:
-//  PASS 2 PlaceBlocks         AllReduce (triangles per block), agreement
-//  PASS 3 SendTriangles       exchange, agreement
-//  PASS 4 FindSharedVertices  exchange, agreement, exchange, agreement
-//  PASS 5 SendHalos           exchange, agreement
+//  PASS 1 ReadSurface         agreement (memory), AllReduce (bounds), AllReduce (triangles),
+//                             agreement
+//  then, for each of up to six passes while the target is not reached and collapses are made:
+//  PASS 2 PlaceBlocks         agreement, AllReduce (triangles per block), agreement
+//  PASS 3 SendTriangles       agreement, exchange, agreement
+//  PASS 4 FindSharedVertices  agreement, exchange, agreement, exchange, agreement
+//  PASS 5 SendHalos           agreement, exchange, agreement
 //  PASS 6 SimplifyBlocks      agreement
-//  PASS 7 KeepCheapest        AllReduce (collapses found); when they are more than needed, one
-//                             AllReduce per bisection step and an AllGather; agreement,
-//                             AllReduce (triangles, collapses, error)
+//  PASS 7 KeepCheapest        AllReduce (collapses found, free and fixed vertices); when more
+//                             are found than needed, one AllReduce per bisection step (the
+//                             same number on every rank: they see the same sums) and an
+//                             AllGather; agreement; AllReduce (triangles, collapses);
+//                             AllReduce (error); agreement
 //  PASS 8 NumberSurface       agreement; vtkRGSeamRepair's own schedule (no smoothing)
 int vtkRGDecimate::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)

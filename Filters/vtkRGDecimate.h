@@ -27,11 +27,13 @@
  * bounds and triangle count). A triangle belongs to the block of its lowest-numbered vertex.
  * Each block is simplified greedily on its own, with the vertices it shares with other blocks
  * fixed, so blocks are independent: their result does not depend on where or in what order they
- * are simplified. A second and a third pass with the grid shifted by half and a quarter block
- * simplify what the first left fixed. In each pass, how many collapses each block keeps is set by
- * one threshold on the collapses' error over all blocks (a distributed selection, ties broken by
- * block and order), so the cheapest collapses of the whole surface are the ones made and the
- * triangle count lands on the target.
+ * are simplified. Further passes (up to six) with the grid shifted by a half, a quarter, ... of a
+ * block simplify what the ones before left fixed. In each pass, how many collapses each block
+ * keeps is set by one threshold on the collapses' error over all blocks (a distributed
+ * selection, ties broken by block and order), so the cheapest collapses of the whole surface are
+ * the ones made; a pass that is not the last makes only the free vertices' share of what is
+ * still needed, so that the blocks' insides are not decimated further than the whole surface
+ * will be, and the triangle count lands on the target.
  * Steps of a pass:
  * 1. Count the triangles of each block (AllReduce); blocks go to ranks in contiguous ranges of
  *    balanced counts.
