@@ -59,8 +59,11 @@ enum Tags
 
 constexpr int MaximumBlocksPerAxis = 32;
 // The grid's offsets, in blocks, in the passes: each pass frees what the ones before left fixed.
-constexpr double PassOffsets[] = { 0.0, 0.5, 0.25, 0.75, 0.125, 0.625 };
-constexpr int Passes = 6;
+constexpr double PassOffsets[] = { 0.0, 0.5, 0.25, 0.75, 0.125, 0.625, 0.375, 0.875 };
+constexpr int Passes = 16;
+// From this pass on, each makes all the collapses still needed that it can, not only its free
+// vertices' share: with small blocks (most vertices near a face) the shares shrink slowly.
+constexpr int AllFromPass = 5;
 
 /// A global id as a radix-sort key, in the ids' signed order.
 std::uint64_t KeyOf(vtkIdType id)
@@ -334,7 +337,7 @@ int vtkRGDecimate::RequestData(
     // PASS 2-7: one pass of block simplification.
     if (!this->PlaceBlocks(run, pass) || !this->SendTriangles(run) ||
       !this->FindSharedVertices(run) || !this->SendHalos(run) || !this->SimplifyBlocks(run) ||
-      !this->KeepCheapest(run, pass == Passes - 1))
+      !this->KeepCheapest(run, pass >= AllFromPass))
     {
       return fail();
     }
@@ -499,7 +502,7 @@ bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
   {
     grid.Dims[a] = static_cast<int>(std::floor((run.upper[a] - run.lower[a]) / grid.Size)) + 2;
   }
-  grid.Offset = PassOffsets[pass];
+  grid.Offset = PassOffsets[pass % (sizeof PassOffsets / sizeof PassOffsets[0])];
   std::vector<vtkIdType> mine;
   if (!run.ranks.Step("count the triangles of the blocks", run.problem,
         [&]()
