@@ -293,7 +293,7 @@ struct vtkRGDecimate::Run
 //  PASS 0 CheckInput          agreement (properties, triangles, ids, finite points)
 //  PASS 1 ReadSurface         agreement (memory), AllReduce (bounds), AllReduce (triangles),
 //                             agreement
-//  then, for each of up to six passes while the target is not reached and collapses are made:
+//  then, for each of up to 16 passes while the target is not reached and collapses are made:
 //  PASS 2 PlaceBlocks         agreement, AllReduce (triangles per block), agreement
 //  PASS 3 SendTriangles       agreement, exchange, agreement
 //  PASS 4 FindSharedVertices  agreement, exchange, agreement, exchange, agreement

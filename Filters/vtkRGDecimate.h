@@ -27,7 +27,7 @@
  * bounds and triangle count). A triangle belongs to the block of its lowest-numbered vertex.
  * Each block is simplified greedily on its own, with the vertices it shares with other blocks
  * fixed, so blocks are independent: their result does not depend on where or in what order they
- * are simplified. Further passes (up to six) with the grid shifted by a half, a quarter, ... of a
+ * are simplified. Further passes (up to 16) with the grid shifted by a half, a quarter, ... of a
  * block simplify what the ones before left fixed. In each pass, how many collapses each block
  * keeps is set by one threshold on the collapses' error over all blocks (a distributed
  * selection, ties broken by block and order), so the cheapest collapses of the whole surface are
