@@ -233,6 +233,58 @@ std::vector<bool> Everyone(int size)
   return std::vector<bool>(static_cast<std::size_t>(size), true);
 }
 
+/// A message of triangles for blocks: their count, (block, three vertex ids) for each of the
+/// `count` that `each(i, block)` gives, then the records of their vertices from `table`, each
+/// once, by increasing id.
+template <typename Each>
+void WriteTriangles(
+  std::vector<vtkIdType>& words, std::size_t count, const VertexTable& table, Each&& each)
+{
+  std::vector<vtkIdType> ids;
+  words.push_back(static_cast<vtkIdType>(count));
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    vtkIdType block;
+    const Triangle& t = each(i, block);
+    words.push_back(block);
+    words.insert(words.end(), t.begin(), t.end());
+    ids.insert(ids.end(), t.begin(), t.end());
+  }
+  SortDistinct(ids);
+  for (vtkIdType id : ids)
+  {
+    table.Write(table.Find(id), words);
+  }
+}
+
+/// Reads what WriteTriangles wrote: each triangle into `list` of its block (`blockWithId`; one
+/// this rank does not own is an error), the vertex records into `table`.
+template <typename BlockWithId>
+void ReadTriangles(const std::vector<vtkIdType>& words, std::vector<Triangle> Block::*list,
+  BlockWithId&& blockWithId, VertexTable& table)
+{
+  if (words.empty())
+  {
+    return;
+  }
+  const vtkIdType n = words[0];
+  std::size_t at = 1;
+  for (vtkIdType t = 0; t < n; ++t, at += 4)
+  {
+    Block* block = blockWithId(words[at]);
+    if (!block)
+    {
+      throw std::runtime_error("triangles came to a rank that does not own their block");
+    }
+    (block->*list).push_back({ words[at + 1], words[at + 2], words[at + 3] });
+  }
+  const std::size_t size = table.Words();
+  for (; at + size <= words.size(); at += size)
+  {
+    table.Read(words.data() + at);
+  }
+}
+
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -562,20 +614,12 @@ bool vtkRGDecimate::SendTriangles(Run& run)
           }
           for (int r = 0; r < size; ++r)
           {
-            std::vector<vtkIdType>& words = outgoing[r];
-            std::vector<vtkIdType> ids;
-            words.push_back(static_cast<vtkIdType>(going[r].size()));
-            for (std::size_t t : going[r])
-            {
-              words.push_back(run.surfaceBlock[t]);
-              words.insert(words.end(), run.surface[t].begin(), run.surface[t].end());
-              ids.insert(ids.end(), run.surface[t].begin(), run.surface[t].end());
-            }
-            SortDistinct(ids);
-            for (vtkIdType id : ids)
-            {
-              run.vertices.Write(run.vertices.Find(id), words);
-            }
+            WriteTriangles(outgoing[r], going[r].size(), run.vertices,
+              [&](std::size_t i, vtkIdType& block) -> const Triangle&
+              {
+                block = run.surfaceBlock[going[r][i]];
+                return run.surface[going[r][i]];
+              });
           }
           std::vector<Triangle>().swap(run.surface);
           std::vector<vtkIdType>().swap(run.surfaceBlock);
@@ -593,26 +637,8 @@ bool vtkRGDecimate::SendTriangles(Run& run)
       run.seen.HasQuadrics = run.quadrics;
       for (const auto& words : incoming)
       {
-        if (words.empty())
-        {
-          continue;
-        }
-        const vtkIdType n = words[0];
-        std::size_t at = 1;
-        for (vtkIdType t = 0; t < n; ++t, at += 4)
-        {
-          Block* block = run.BlockWithId(words[at]);
-          if (!block)
-          {
-            throw std::runtime_error("a triangle came to a rank that does not own its block");
-          }
-          block->Own.push_back({ words[at + 1], words[at + 2], words[at + 3] });
-        }
-        const std::size_t size = run.seen.Words();
-        for (; at + size <= words.size(); at += size)
-        {
-          run.seen.Read(words.data() + at);
-        }
+        ReadTriangles(
+          words, &Block::Own, [&run](vtkIdType id) { return run.BlockWithId(id); }, run.seen);
       }
     });
 }
@@ -750,21 +776,13 @@ bool vtkRGDecimate::SendHalos(Run& run)
               std::array<vtkIdType, 4>{ r, VTK_ID_MIN, VTK_ID_MIN, VTK_ID_MIN });
             auto last = std::lower_bound(going.begin(), going.end(),
               std::array<vtkIdType, 4>{ r + 1, VTK_ID_MIN, VTK_ID_MIN, VTK_ID_MIN });
-            std::vector<vtkIdType>& words = outgoing[r];
-            std::vector<vtkIdType> ids;
-            words.push_back(static_cast<vtkIdType>(last - first));
-            for (auto it = first; it != last; ++it)
-            {
-              const Triangle& t = run.blocks[(*it)[2]].Own[(*it)[3]];
-              words.push_back((*it)[1]);
-              words.insert(words.end(), t.begin(), t.end());
-              ids.insert(ids.end(), t.begin(), t.end());
-            }
-            SortDistinct(ids);
-            for (vtkIdType id : ids)
-            {
-              run.seen.Write(run.seen.Find(id), words);
-            }
+            WriteTriangles(outgoing[r], static_cast<std::size_t>(last - first), run.seen,
+              [&](std::size_t i, vtkIdType& block) -> const Triangle&
+              {
+                const auto& entry = *(first + static_cast<std::ptrdiff_t>(i));
+                block = entry[1];
+                return run.blocks[entry[2]].Own[entry[3]];
+              });
           }
         }))
   {
@@ -778,26 +796,8 @@ bool vtkRGDecimate::SendHalos(Run& run)
     {
       for (const auto& words : incoming)
       {
-        if (words.empty())
-        {
-          continue;
-        }
-        const vtkIdType n = words[0];
-        std::size_t at = 1;
-        for (vtkIdType t = 0; t < n; ++t, at += 4)
-        {
-          Block* block = run.BlockWithId(words[at]);
-          if (!block)
-          {
-            throw std::runtime_error("a halo came to a rank that does not own its block");
-          }
-          block->Halo.push_back({ words[at + 1], words[at + 2], words[at + 3] });
-        }
-        const std::size_t size = run.seen.Words();
-        for (; at + size <= words.size(); at += size)
-        {
-          run.seen.Read(words.data() + at);
-        }
+        ReadTriangles(
+          words, &Block::Halo, [&run](vtkIdType id) { return run.BlockWithId(id); }, run.seen);
       }
       run.seen.SortUnique(seenBefore);
       rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
