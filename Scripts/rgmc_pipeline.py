@@ -48,7 +48,7 @@ def parse_seed(text):
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog="pvbatch rgmc_pipeline.py",
+        prog=os.environ.get("RGMC_PROG", "pvbatch rgmc_pipeline.py"),
         description="Extract the surface of the structure nearest to one or more seed points "
         "(seeded, distributed region-growing marching cubes) and write it as STL and VTP.",
         epilog="Examples: CT bone: --isovalue 400 (HU); CT skin: --isovalue -300; MRI: an "
