@@ -39,6 +39,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__GLIBC__)
+#include <malloc.h> // malloc_trim
+#endif
+
 vtkStandardNewMacro(vtkRGDecimate);
 vtkCxxSetObjectMacro(vtkRGDecimate, Controller, vtkMultiProcessController);
 
@@ -64,6 +68,14 @@ constexpr int Passes = 16;
 // From this pass on, each makes all the collapses still needed that it can, not only its free
 // vertices' share: with small blocks (most vertices near a face) the shares shrink slowly.
 constexpr int AllFromPass = 5;
+
+/// Returns the heap's free pages to the system where the C library can (glibc's malloc_trim).
+void ReleaseFreeMemory()
+{
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
 
 /// A global id as a radix-sort key, in the ids' signed order.
 std::uint64_t KeyOf(vtkIdType id)
@@ -131,6 +143,12 @@ public:
       }
       this->Quadrics.push_back(q);
     }
+  }
+
+  void Reserve(std::size_t n)
+  {
+    this->Vertices.reserve(n);
+    this->Quadrics.reserve(this->HasQuadrics ? n : 0);
   }
 
   void Add(const Vertex& v, const rgmc::Quadric* q)
@@ -394,6 +412,9 @@ int vtkRGDecimate::RequestData(
       return fail();
     }
     run.passes = pass + 1;
+    // The pass's blocks and messages are freed; give their pages back, so that the next pass's
+    // do not come on top of them (glibc keeps freed memory, the threads' arenas most of all).
+    ReleaseFreeMemory();
     this->UpdateProgress(0.05 + 0.8 * (pass + 1) / Passes);
     if (run.collapses == 0)
     {
@@ -628,17 +649,18 @@ bool vtkRGDecimate::SendTriangles(Run& run)
   {
     return false;
   }
-  const auto incoming = run.ranks.Exchange(outgoing, Everyone(size), TrianglesTag);
+  auto incoming = run.ranks.Exchange(outgoing, Everyone(size), TrianglesTag);
   outgoing.clear();
   return run.ranks.Step("receive the blocks' triangles", run.problem,
     [&]()
     {
       run.seen.Clear();
       run.seen.HasQuadrics = run.quadrics;
-      for (const auto& words : incoming)
+      for (auto& words : incoming)
       {
         ReadTriangles(
           words, &Block::Own, [&run](vtkIdType id) { return run.BlockWithId(id); }, run.seen);
+        std::vector<vtkIdType>().swap(words); // read: its memory goes back at once
       }
     });
 }
@@ -788,16 +810,17 @@ bool vtkRGDecimate::SendHalos(Run& run)
   {
     return false;
   }
-  const auto incoming = run.ranks.Exchange(outgoing, Everyone(size), HaloTag);
+  auto incoming = run.ranks.Exchange(outgoing, Everyone(size), HaloTag);
   const std::size_t seenBefore = run.seen.Vertices.size();
   outgoing.clear();
   return run.ranks.Step("assemble the blocks", run.problem,
     [&]()
     {
-      for (const auto& words : incoming)
+      for (auto& words : incoming)
       {
         ReadTriangles(
           words, &Block::Halo, [&run](vtkIdType id) { return run.BlockWithId(id); }, run.seen);
+        std::vector<vtkIdType>().swap(words);
       }
       run.seen.SortUnique(seenBefore);
       rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
@@ -997,24 +1020,49 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
         {
           run.vertices.Clear();
           run.vertices.HasQuadrics = true;
-          for (Block& block : run.blocks)
+          // The blocks' collapses are replayed in parallel (each block alone); then the new
+          // surface and vertex records are sized once, and filled block after block, each
+          // block freed as soon as it is copied, so that the largest of these lists is not
+          // made twice by growing.
+          std::vector<std::vector<char>> used(run.blocks.size());
+          rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
+            [&](vtkIdType first, vtkIdType last)
+            {
+              for (vtkIdType b = first; b < last; ++b)
+              {
+                Block& block = run.blocks[b];
+                rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
+                used[b].assign(block.Mesh.Ids.size(), 0);
+                for (const auto& t : block.Mesh.Triangles)
+                {
+                  used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
+                }
+              }
+            });
+          std::size_t triangles = 0, records = 0;
+          for (std::size_t b = 0; b < run.blocks.size(); ++b)
           {
-            rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
+            triangles += run.blocks[b].Mesh.Triangles.size();
+            records += static_cast<std::size_t>(std::count(used[b].begin(), used[b].end(), 1));
+          }
+          run.surface.reserve(triangles);
+          run.vertices.Reserve(records);
+          for (std::size_t b = 0; b < run.blocks.size(); ++b)
+          {
+            Block& block = run.blocks[b];
             kept += static_cast<vtkIdType>(block.Keep);
             if (block.Keep > 0)
             {
               level = std::max(level, block.Log[block.Keep - 1].Level);
             }
             const rgmc::DecimationBlock& mesh = block.Mesh;
-            std::vector<char> used(mesh.Ids.size(), 0);
             for (const auto& t : mesh.Triangles)
             {
               run.surface.push_back({ mesh.Ids[t[0]], mesh.Ids[t[1]], mesh.Ids[t[2]] });
-              used[t[0]] = used[t[1]] = used[t[2]] = 1;
             }
-            for (std::size_t v = 0; v < used.size(); ++v)
+            for (std::size_t v = 0; v < used[b].size(); ++v)
             {
-              if (used[v])
+              if (used[b][v])
               {
                 Vertex record;
                 record.Id = mesh.Ids[v];
@@ -1023,6 +1071,7 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
               }
             }
             block = Block{ block.Id, {}, {}, {}, {}, {}, 0 };
+            std::vector<char>().swap(used[b]);
           }
           run.vertices.SortUnique();
           run.blocks.clear();
