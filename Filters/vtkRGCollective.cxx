@@ -149,8 +149,8 @@ std::vector<int> Ranks::TournamentOrder(const std::vector<bool>& partners) const
 }
 
 template <typename T>
-std::vector<std::vector<T>> Ranks::ExchangeAny(
-  const std::vector<std::vector<T>>& outgoing, const std::vector<int>& order, int tag)
+std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>& outgoing,
+  const std::vector<int>& order, int tag, std::vector<std::vector<T>>* consumed)
 {
   std::vector<std::vector<T>> incoming(this->Size);
   const int me = this->Rank;
@@ -212,9 +212,20 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(
       receive();
       send();
     }
+    if (consumed)
+    {
+      std::vector<T>().swap((*consumed)[partner]);
+    }
   }
   // What a rank "sends" to itself stays here.
-  incoming[me] = outgoing[me];
+  if (consumed)
+  {
+    incoming[me].swap((*consumed)[me]);
+  }
+  else
+  {
+    incoming[me] = outgoing[me];
+  }
   return incoming;
 }
 
@@ -222,6 +233,12 @@ std::vector<std::vector<vtkIdType>> Ranks::Exchange(
   const std::vector<std::vector<vtkIdType>>& outgoing, const std::vector<bool>& partners, int tag)
 {
   return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag);
+}
+
+std::vector<std::vector<vtkIdType>> Ranks::Exchange(
+  std::vector<std::vector<vtkIdType>>&& outgoing, const std::vector<bool>& partners, int tag)
+{
+  return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag, &outgoing);
 }
 
 std::vector<std::vector<double>> Ranks::Exchange(

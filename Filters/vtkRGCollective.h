@@ -101,6 +101,11 @@ public:
   std::vector<std::vector<vtkIdType>> Exchange(const std::vector<std::vector<vtkIdType>>& outgoing,
     const std::vector<bool>& partners, int tag);
 
+  /// Exchange that consumes `outgoing`: each message is freed once sent, and what a rank sends
+  /// to itself is moved, not copied, so the messages are not held twice.
+  std::vector<std::vector<vtkIdType>> Exchange(
+    std::vector<std::vector<vtkIdType>>&& outgoing, const std::vector<bool>& partners, int tag);
+
   /// Exchange for doubles.
   std::vector<std::vector<double>> Exchange(
     const std::vector<std::vector<double>>& outgoing, const std::vector<bool>& partners, int tag);
@@ -178,9 +183,11 @@ private:
   /// The partners of `partners` in the order of a round-robin tournament over all ranks.
   std::vector<int> TournamentOrder(const std::vector<bool>& partners) const;
 
+  /// With `consumed` (the same list as `outgoing`, given as modifiable), frees each message once
+  /// sent and moves the rank's own: the list is left with empty messages.
   template <typename T>
-  std::vector<std::vector<T>> ExchangeAny(
-    const std::vector<std::vector<T>>& outgoing, const std::vector<int>& order, int tag);
+  std::vector<std::vector<T>> ExchangeAny(const std::vector<std::vector<T>>& outgoing,
+    const std::vector<int>& order, int tag, std::vector<std::vector<T>>* consumed = nullptr);
 };
 
 } // namespace rgmc

@@ -37,6 +37,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__GLIBC__)
@@ -649,7 +650,7 @@ bool vtkRGDecimate::SendTriangles(Run& run)
   {
     return false;
   }
-  auto incoming = run.ranks.Exchange(outgoing, Everyone(size), TrianglesTag);
+  auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), TrianglesTag);
   outgoing.clear();
   return run.ranks.Step("receive the blocks' triangles", run.problem,
     [&]()
@@ -694,7 +695,7 @@ bool vtkRGDecimate::FindSharedVertices(Run& run)
   {
     return false;
   }
-  const auto pairs = run.ranks.Exchange(outgoing, Everyone(size), SharedTag);
+  const auto pairs = run.ranks.Exchange(std::move(outgoing), Everyone(size), SharedTag);
   std::vector<std::vector<vtkIdType>> answers(static_cast<std::size_t>(size));
   if (!run.ranks.Step("find the shared vertices", run.problem,
         [&]()
@@ -731,7 +732,7 @@ bool vtkRGDecimate::FindSharedVertices(Run& run)
   {
     return false;
   }
-  const auto told = run.ranks.Exchange(answers, Everyone(size), AnswersTag);
+  const auto told = run.ranks.Exchange(std::move(answers), Everyone(size), AnswersTag);
   return run.ranks.Step("record the shared vertices", run.problem,
     [&]()
     {
@@ -810,7 +811,7 @@ bool vtkRGDecimate::SendHalos(Run& run)
   {
     return false;
   }
-  auto incoming = run.ranks.Exchange(outgoing, Everyone(size), HaloTag);
+  auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), HaloTag);
   const std::size_t seenBefore = run.seen.Vertices.size();
   outgoing.clear();
   return run.ranks.Step("assemble the blocks", run.problem,
