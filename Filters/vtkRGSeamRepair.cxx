@@ -217,9 +217,28 @@ public:
 
   /// Collective: AllGather and AllGatherV (the samples), an agreement, an exchange with every
   /// rank (the identities), an agreement, an AllGather (the count each range numbered), an
-  /// exchange (the answers), an agreement. False (on every rank, with `problem`) on failure.
+  /// exchange (the answers), an agreement; on one rank, one agreement. False (on every rank,
+  /// with `problem`) on failure.
   bool Number(GlobalNumbering& numbering, std::string& problem)
   {
+    if (this->AllRanks.Size == 1)
+    {
+      // Alone: the distinct identities, sorted, are numbered in order (what the merge below
+      // gives with one stream, without its heap).
+      return this->AllRanks.Step("number the vertices", problem,
+        [&]()
+        {
+          numbering.Total = this->Vertices.Count;
+          numbering.Gid.resize(static_cast<std::size_t>(this->Vertices.Count));
+          for (vtkIdType i = 0; i < this->Vertices.Count; ++i)
+          {
+            numbering.Gid[this->Vertices.Sorted[i]] = i;
+          }
+          numbering.Holding.assign(
+            static_cast<std::size_t>(this->Vertices.Count), GlobalNumbering::Alone);
+          std::vector<Identity<Words>>().swap(this->Ids);
+        });
+    }
     const std::vector<bool> everyone(this->AllRanks.Size, true);
     this->GatherSamples();
     std::vector<std::vector<vtkIdType>> toRanges(this->AllRanks.Size);
@@ -1771,7 +1790,8 @@ struct vtkRGSeamRepair::Run
 //  PASS 0 CheckInput      agreement (a triangle mesh), AllReduce (triangles), agreement
 //  PASS 1 NumberVertices  AllReduce (whether every rank has vertex keys), agreement (the
 //                         local sort); IdentityNumbering: AllGather, AllGatherV, agreement,
-//                         exchange, agreement, AllGather, exchange, agreement
+//                         exchange, agreement, AllGather, exchange, agreement (one rank: an
+//                         agreement)
 //  PASS 2 FindBorder      3 AllReduce (the bounds, whether every rank has the volume's box)
 //  PASS 3 RepairSeams     agreement (the input copied); AnalyzeSeams: agreement, exchange,
 //                         agreement, exchange, agreement
@@ -1997,7 +2017,6 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
   {
     return false;
   }
-  run.after = run.before;
   run.after = run.before;
   this->UpdateProgress(0.4);
   if (run.smooth)
