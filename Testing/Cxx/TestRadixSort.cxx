@@ -72,5 +72,5 @@ int main()
     }
     Check(keys, "one varying byte");
   }
-  return 0;
+  return rgmc_test::Result("TestRadixSort");
 }
