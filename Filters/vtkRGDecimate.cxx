@@ -651,7 +651,6 @@ bool vtkRGDecimate::SendTriangles(Run& run)
     return false;
   }
   auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), TrianglesTag);
-  outgoing.clear();
   return run.ranks.Step("receive the blocks' triangles", run.problem,
     [&]()
     {
@@ -813,7 +812,6 @@ bool vtkRGDecimate::SendHalos(Run& run)
   }
   auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), HaloTag);
   const std::size_t seenBefore = run.seen.Vertices.size();
-  outgoing.clear();
   return run.ranks.Step("assemble the blocks", run.problem,
     [&]()
     {
