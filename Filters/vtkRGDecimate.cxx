@@ -873,6 +873,8 @@ bool vtkRGDecimate::SendHalos(Run& run)
             mesh.SortTriangles();
             if (!run.quadrics)
             {
+              // Area-weighted unless an error bound is asked for: see MaximumError.
+              mesh.AreaWeighted = !(this->MaximumError > 0.0);
               mesh.ComputeQuadrics();
             }
           }

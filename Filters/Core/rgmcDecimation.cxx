@@ -8,7 +8,8 @@
 namespace rgmc
 {
 
-Quadric Quadric::OfTriangle(const double a[3], const double b[3], const double c[3])
+Quadric Quadric::OfTriangle(
+  const double a[3], const double b[3], const double c[3], bool areaWeighted)
 {
   const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
   const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
@@ -25,6 +26,14 @@ Quadric Quadric::OfTriangle(const double a[3], const double b[3], const double c
   const double d = -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]);
   q.Terms = { n[0] * n[0], n[0] * n[1], n[0] * n[2], n[0] * d, n[1] * n[1], n[1] * n[2], n[1] * d,
     n[2] * n[2], n[2] * d, d * d };
+  if (areaWeighted)
+  {
+    const double area = 0.5 * length;
+    for (double& term : q.Terms)
+    {
+      term *= area;
+    }
+  }
   return q;
 }
 
@@ -44,6 +53,71 @@ double Quadric::Error(const double p[3]) const
   const double x = p[0], y = p[1], z = p[2];
   return x * (q[0] * x + 2.0 * (q[1] * y + q[2] * z + q[3])) +
     y * (q[4] * y + 2.0 * (q[5] * z + q[6])) + z * (q[7] * z + 2.0 * q[8]) + q[9];
+}
+
+double PlaceCollapse(const Quadric& q, const double pa[3], const double pb[3], double position[3])
+{
+  const auto& m = q.Terms;
+  const double mid[3] = { 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2]) };
+  const double d[3] = { pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2] };
+  const double edge2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  auto take = [&q, position](const double x[3])
+  {
+    std::copy(x, x + 3, position);
+    return q.Error(x);
+  };
+  double cost = HUGE_VAL;
+  // A x = -b by Cramer's rule.
+  const double c00 = m[4] * m[7] - m[5] * m[5];
+  const double c01 = m[2] * m[5] - m[1] * m[7];
+  const double c02 = m[1] * m[5] - m[2] * m[4];
+  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+  const double trace = m[0] + m[4] + m[7];
+  if (trace > 0.0 && std::abs(det) > 1e-10 * trace * trace * trace)
+  {
+    const double c11 = m[0] * m[7] - m[2] * m[2];
+    const double c12 = m[1] * m[2] - m[0] * m[5];
+    const double c22 = m[0] * m[4] - m[1] * m[1];
+    const double r[3] = { -m[3], -m[6], -m[8] };
+    const double x[3] = { (c00 * r[0] + c01 * r[1] + c02 * r[2]) / det,
+      (c01 * r[0] + c11 * r[1] + c12 * r[2]) / det, (c02 * r[0] + c12 * r[1] + c22 * r[2]) / det };
+    const double d2 = (x[0] - mid[0]) * (x[0] - mid[0]) + (x[1] - mid[1]) * (x[1] - mid[1]) +
+      (x[2] - mid[2]) * (x[2] - mid[2]);
+    if (std::isfinite(d2) && d2 <= 4.0 * edge2)
+    {
+      cost = take(x);
+    }
+  }
+  if (!std::isfinite(cost))
+  {
+    // On the edge pa + t d: Q = Q(pa) + 2 t g.d + t^2 d.A d, g = A pa + b.
+    const double ad[3] = { m[0] * d[0] + m[1] * d[1] + m[2] * d[2],
+      m[1] * d[0] + m[4] * d[1] + m[5] * d[2], m[2] * d[0] + m[5] * d[1] + m[7] * d[2] };
+    const double g[3] = { m[0] * pa[0] + m[1] * pa[1] + m[2] * pa[2] + m[3],
+      m[1] * pa[0] + m[4] * pa[1] + m[5] * pa[2] + m[6],
+      m[2] * pa[0] + m[5] * pa[1] + m[7] * pa[2] + m[8] };
+    const double curvature = d[0] * ad[0] + d[1] * ad[1] + d[2] * ad[2];
+    const double slope = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+    if (curvature > 0.0)
+    {
+      const double t = std::min(1.0, std::max(0.0, -slope / curvature));
+      const double x[3] = { pa[0] + t * d[0], pa[1] + t * d[1], pa[2] + t * d[2] };
+      cost = take(x);
+    }
+  }
+  if (!std::isfinite(cost))
+  {
+    cost = take(mid);
+    for (const double* end : { pa, pb })
+    {
+      const double e = q.Error(end);
+      if (e < cost)
+      {
+        cost = take(end);
+      }
+    }
+  }
+  return std::isfinite(cost) ? std::max(0.0, cost) : HUGE_VAL;
 }
 
 namespace
@@ -252,59 +326,11 @@ private:
     return Candidate{ this->Place(a, b, position), a, b, this->Stamp[a], this->Stamp[b] };
   }
 
-  // The best position for the merged vertex of a and b, and its error: the quadric's minimum
-  // when well defined and near the edge, else the best of the midpoint and the two ends.
+  // The merged vertex of a and b: see PlaceCollapse.
   double Place(int a, int b, double position[3]) const
   {
-    double cost;
-    const Quadric q = this->Quadrics[a] + this->Quadrics[b];
-    const auto& m = q.Terms;
-    const double* pa = this->Point(a);
-    const double* pb = this->Point(b);
-    const double mid[3] = { 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2]) };
-    // A x = -b by Cramer's rule, for a well conditioned A only.
-    const double c00 = m[4] * m[7] - m[5] * m[5];
-    const double c01 = m[2] * m[5] - m[1] * m[7];
-    const double c02 = m[1] * m[5] - m[2] * m[4];
-    const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
-    const double trace = m[0] + m[4] + m[7];
-    const double edge2 = (pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
-      (pa[2] - pb[2]) * (pa[2] - pb[2]);
-    bool solved = false;
-    if (trace > 0.0 && std::abs(det) > 1e-6 * trace * trace * trace)
-    {
-      const double c11 = m[0] * m[7] - m[2] * m[2];
-      const double c12 = m[1] * m[2] - m[0] * m[5];
-      const double c22 = m[0] * m[4] - m[1] * m[1];
-      const double r[3] = { -m[3], -m[6], -m[8] };
-      const double x[3] = { (c00 * r[0] + c01 * r[1] + c02 * r[2]) / det,
-        (c01 * r[0] + c11 * r[1] + c12 * r[2]) / det,
-        (c02 * r[0] + c12 * r[1] + c22 * r[2]) / det };
-      const double d2 = (x[0] - mid[0]) * (x[0] - mid[0]) + (x[1] - mid[1]) * (x[1] - mid[1]) +
-        (x[2] - mid[2]) * (x[2] - mid[2]);
-      if (std::isfinite(d2) && d2 <= edge2)
-      {
-        std::copy(x, x + 3, position);
-        cost = q.Error(x);
-        solved = true;
-      }
-    }
-    if (!solved)
-    {
-      const double* options[3] = { mid, pa, pb };
-      cost = q.Error(mid);
-      std::copy(mid, mid + 3, position);
-      for (int i = 1; i < 3; ++i)
-      {
-        const double e = q.Error(options[i]);
-        if (e < cost)
-        {
-          cost = e;
-          std::copy(options[i], options[i] + 3, position);
-        }
-      }
-    }
-    return std::isfinite(cost) ? std::max(0.0, cost) : HUGE_VAL;
+    return PlaceCollapse(
+      this->Quadrics[a] + this->Quadrics[b], this->Point(a), this->Point(b), position);
   }
 
   void QueueAllEdges()
@@ -502,7 +528,8 @@ void DecimationBlock::ComputeQuadrics()
       continue;
     }
     const double* p = this->Points.data();
-    const Quadric q = Quadric::OfTriangle(p + 3 * t[0], p + 3 * t[1], p + 3 * t[2]);
+    const Quadric q =
+      Quadric::OfTriangle(p + 3 * t[0], p + 3 * t[1], p + 3 * t[2], this->AreaWeighted);
     for (int v : t)
     {
       if (used[v])

@@ -24,11 +24,21 @@ struct Quadric
 {
   std::array<double, 10> Terms{};
 
-  /// The quadric of the plane through `a`, `b`, `c` (counter-clockwise); zero when degenerate.
-  static Quadric OfTriangle(const double a[3], const double b[3], const double c[3]);
+  /// The quadric of the plane through `a`, `b`, `c` (counter-clockwise), times the triangle's
+  /// area when `areaWeighted`; zero when degenerate.
+  static Quadric OfTriangle(
+    const double a[3], const double b[3], const double c[3], bool areaWeighted = false);
   Quadric operator+(const Quadric& other) const;
   double Error(const double p[3]) const;
 };
+
+/// Where an edge collapse puts the merged vertex of the edge from `pa` to `pb`, whose ends'
+/// quadrics sum to `q`, and the quadric's error there: the quadric's minimum when its matrix A
+/// is not near singular (|det A| > 1e-10 trace(A)^3, vtkQuadricDecimation's test) and the
+/// minimum lies within two edge lengths of the edge's midpoint; else the minimum on the edge
+/// (a crease, a plane: A is singular); else (A flat along the edge) the best of the midpoint
+/// and the two ends. HUGE_VAL when no error is finite.
+double PlaceCollapse(const Quadric& q, const double pa[3], const double pb[3], double position[3]);
 
 /// One block: its vertices (sorted global ids, positions, quadrics), its own triangles and the
 /// halo triangles, as indices into the vertices.
@@ -40,6 +50,11 @@ struct DecimationBlock
   std::vector<std::uint8_t> Fixed;           // per vertex: has a triangle in another block
   std::vector<std::array<int, 3>> Triangles; // the block's own, in canonical order
   std::vector<std::array<int, 3>> Halo;      // other blocks' triangles around its vertices
+  /// Whether ComputeQuadrics weights each plane by its triangle's area (Garland's thesis, and
+  /// vtkQuadricDecimation): the error then follows the surface's shape, not how finely each of
+  /// its parts is triangulated. Unweighted, a collapse's error is the root of the summed squared
+  /// distances to the planes, a bound on each (what a maximum error limits).
+  bool AreaWeighted = false;
 
   /// Puts the triangles in canonical order: each rotated to start at its lowest vertex
   /// (orientation kept), then sorted. Call before anything else.
