@@ -6,7 +6,13 @@
  * on every rank) to a fraction of its triangles by edge collapses chosen by their quadric error
  * (Garland and Heckbert, "Surface simplification using quadric error metrics", SIGGRAPH 1997):
  * each vertex carries the sum of the squared-distance quadrics of the triangles merged into it,
- * and the cheapest collapse goes first, the merged vertex placed where its quadric is smallest.
+ * and the cheapest collapse goes first, the merged vertex placed where its quadric is smallest
+ * (rgmc::PlaceCollapse: the quadric's minimum when it is well defined and within two edge lengths
+ * of the edge, else its minimum on the edge). Without a MaximumError each plane's quadric is
+ * weighted by its triangle's area, as in Garland's thesis and vtkQuadricDecimation, so that the
+ * error follows the surface's shape rather than how finely marching cubes cut each part of it
+ * (its slivers count for little); with a MaximumError the planes count equally, so that the error
+ * bounds the distance to each of them.
  *
  * What is kept:
  * - a closed manifold stays one, of the same topology: a collapse is made only when the edge's
@@ -83,7 +89,8 @@ public:
   ///@{
   /**
    * The largest quadric error of a collapse, in world units (default 0: no limit); see the
-   * warning above.
+   * warning above. When set, the quadrics are not area-weighted (see the class description), so
+   * that the bound holds for every plane.
    */
   vtkSetMacro(MaximumError, double);
   vtkGetMacro(MaximumError, double);
