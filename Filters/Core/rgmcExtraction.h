@@ -315,25 +315,14 @@ private:
     chunk.LowK = box.Lo[2] + first;
     chunk.TopK = box.Lo[2] + last; // the plane above the last slab
     // A node emits at most its case's triangles; a closed surface has about half as many
-    // vertices as triangles.
+    // vertices as triangles. A chunk's vertices are keys and components only: their positions
+    // and normals are computed from the keys into the joined mesh (CopyChunks).
     LocalMesh& m = chunk.Mesh;
     const std::size_t vertices = static_cast<std::size_t>(triangles / 2 + 64);
     m.Triangles.reserve(static_cast<std::size_t>(3 * triangles));
     m.TriangleComponent.reserve(static_cast<std::size_t>(triangles));
     m.Keys.reserve(vertices);
     m.VertexComponent.reserve(vertices);
-    if (this->Volume.Options.DoublePoints)
-    {
-      m.PointsDouble.reserve(3 * vertices);
-    }
-    else
-    {
-      m.Points.reserve(3 * vertices);
-    }
-    if (this->Volume.Options.ComputeNormals)
-    {
-      m.Normals.reserve(3 * vertices);
-    }
     // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,
     // z edges inside it. The top plane becomes the next slab's bottom.
     EdgeLayer* bottom[2] = { &work.Layers[0], &work.Layers[1] }; // x, y edges at z = k
@@ -353,9 +342,9 @@ private:
       {
         if (n + PrefetchAhead < start[s + 1])
         {
+          // The vertices' slots of a node soon emitted: rows j and j + 1 of the slab's edge
+          // layers.
           const SurfaceNode& ahead = nodes[n + PrefetchAhead];
-          this->Volume.PrefetchAround(ahead.I, ahead.J, ahead.K);
-          // And its vertices' slots: rows j and j + 1 of the slab's edge layers.
           const std::int64_t at =
             (ahead.I - box.Lo[0]) + this->LayerNx * std::int64_t(ahead.J - box.Lo[1]);
           for (EdgeLayer* layer : { bottom[0], bottom[1], top[0], top[1], vertical })
@@ -364,11 +353,15 @@ private:
             __builtin_prefetch(&layer->Ids[at + this->LayerNx]);
           }
         }
+        // A cube without a degenerate sample needs only its case (growth read its samples);
+        // a degenerate one is described from its samples again.
         const SurfaceNode& node = nodes[n];
-        if (this->Volume.Evaluate(node.I, node.J, node.K, st))
+        st.Case = node.Case;
+        st.Degenerate = node.Degenerate;
+        if (!node.Degenerate || this->Volume.Evaluate(node.I, node.J, node.K, st))
         {
           this->Volume.Describe(node.I, node.J, node.K, st, surface);
-          this->Emit(work, node, st, surface);
+          this->Emit(work, node, surface);
         }
       }
       for (EdgeLayer* layer : { bottom[0], bottom[1], vertical })
@@ -383,12 +376,10 @@ private:
     chunk.Joins.erase(std::unique(chunk.Joins.begin(), chunk.Joins.end()), chunk.Joins.end());
   }
 
-  /// Creates the output point of a vertex in a chunk: position, normal, component, port check.
-  std::int32_t NewVertex(ChunkWork& work, const SurfaceVertex& v, double sLo, double sHi, int comp)
+  /// Creates the output point of a vertex in a chunk: key, component, port check (its position
+  /// and normal come at the join).
+  std::int32_t NewVertex(ChunkWork& work, const SurfaceVertex& v, int comp)
   {
-    double x[3];
-    float normal[3] = { 0, 0, 0 };
-    this->Volume.PositionAndNormal(v.Point, v.Axis, sLo, sHi, x, normal);
     Chunk& chunk = *work.Out;
     LocalMesh& m = chunk.Mesh;
     // Vertex ids are 32-bit within a rank (slots hold id + 1).
@@ -397,20 +388,6 @@ private:
       throw std::length_error("more than 2147483646 surface vertices in one piece");
     }
     const std::int32_t id = static_cast<std::int32_t>(m.Keys.size());
-    if (this->Volume.Options.DoublePoints)
-    {
-      m.PointsDouble.append(x, 3);
-    }
-    else
-    {
-      const float xf[3] = { static_cast<float>(x[0]), static_cast<float>(x[1]),
-        static_cast<float>(x[2]) };
-      m.Points.append(xf, 3);
-    }
-    if (this->Volume.Options.ComputeNormals)
-    {
-      m.Normals.append(normal, 3);
-    }
     m.Keys.push_back(v.Key);
     m.VertexComponent.push_back(comp);
     if (v.Axis != 2 && v.Point[2] == chunk.LowK)
@@ -431,7 +408,7 @@ private:
   /// The output point of a vertex met by component `comp`, whose id + 1 is kept in `slot` (0:
   /// none yet): made on first use; met again by another component, the two are to be joined.
   RGMC_INLINE std::int32_t UseVertex(ChunkWork& work, std::int32_t& slot, const SurfaceVertex& v,
-    double sLo, double sHi, int comp, EdgeLayer* layer, std::int32_t index)
+    int comp, EdgeLayer* layer, std::int32_t index)
   {
     if (slot > 0)
     {
@@ -442,7 +419,7 @@ private:
       }
       return slot - 1;
     }
-    const std::int32_t id = this->NewVertex(work, v, sLo, sHi, comp);
+    const std::int32_t id = this->NewVertex(work, v, comp);
     slot = id + 1;
     if (layer)
     {
@@ -453,29 +430,27 @@ private:
 
   /// The output point of a vertex of the current node's cube: on an edge (kept in the slab's
   /// edge layers) or on a grid point (kept in a map).
-  RGMC_INLINE std::int32_t Vertex(
-    ChunkWork& work, const SurfaceNode& n, const SurfaceVertex& v, const CubeSamples& st)
+  RGMC_INLINE std::int32_t Vertex(ChunkWork& work, const SurfaceNode& n, const SurfaceVertex& v)
   {
     if (v.Axis < 0)
     {
       bool inserted;
       std::int32_t& slot = work.PointVertices->FindOrInsert(v.Key, 0, inserted);
-      return this->UseVertex(work, slot, v, 0.0, 0.0, n.Component, nullptr, 0);
+      return this->UseVertex(work, slot, v, n.Component, nullptr, 0);
     }
     const CellBox& box = this->NodeBox;
     const std::int32_t index = static_cast<std::int32_t>(
       (v.Point[0] - box.Lo[0]) + this->LayerNx * (v.Point[1] - box.Lo[1]));
     EdgeLayer* layer =
       v.Axis == 2 ? work.VerticalLayer : work.SlabLayers[v.Point[2] - work.SlabK][v.Axis];
-    return this->UseVertex(work, layer->Ids[index], v, st.S[EdgeCorners[v.Edge][0]],
-      st.S[EdgeCorners[v.Edge][1]], n.Component, layer, index);
+    return this->UseVertex(work, layer->Ids[index], v, n.Component, layer, index);
   }
 
   /// The output point of the vertex on edge e of a cube without a degenerate sample: its slot
   /// found from the cube's place in the edge layers (`at`) and the edge, the vertex itself
   /// (its key) made only when it is new.
-  RGMC_INLINE std::int32_t EdgeVertex(ChunkWork& work, const SurfaceNode& n, int e, std::int32_t at,
-    const CubeSamples& st, const CubeSurface& surface)
+  RGMC_INLINE std::int32_t EdgeVertex(
+    ChunkWork& work, const SurfaceNode& n, int e, std::int32_t at, const CubeSurface& surface)
   {
     const int* o = CornerOffset[EdgeCorners[e][0]];
     const int axis = CubeEdgeAxis[e];
@@ -484,15 +459,13 @@ private:
     std::int32_t& slot = layer->Ids[index];
     if (slot > 0)
     {
-      return this->UseVertex(work, slot, SurfaceVertex(), 0.0, 0.0, n.Component, layer, index);
+      return this->UseVertex(work, slot, SurfaceVertex(), n.Component, layer, index);
     }
-    return this->UseVertex(work, slot, surface.EdgeVertex(e), st.S[EdgeCorners[e][0]],
-      st.S[EdgeCorners[e][1]], n.Component, layer, index);
+    return this->UseVertex(work, slot, surface.EdgeVertex(e), n.Component, layer, index);
   }
 
   /// Emits the triangles of one node.
-  void Emit(
-    ChunkWork& work, const SurfaceNode& n, const CubeSamples& st, const CubeSurface& surface)
+  void Emit(ChunkWork& work, const SurfaceNode& n, const CubeSurface& surface)
   {
     LocalMesh& m = work.Out->Mesh;
     if (!surface.Degenerate())
@@ -506,9 +479,9 @@ private:
         if (entry.TriangleSheet[t] == n.Node)
         {
           const std::int32_t ids[3] = { this->EdgeVertex(
-                                          work, n, entry.Triangles[t][0], at, st, surface),
-            this->EdgeVertex(work, n, entry.Triangles[t][1], at, st, surface),
-            this->EdgeVertex(work, n, entry.Triangles[t][2], at, st, surface) };
+                                          work, n, entry.Triangles[t][0], at, surface),
+            this->EdgeVertex(work, n, entry.Triangles[t][1], at, surface),
+            this->EdgeVertex(work, n, entry.Triangles[t][2], at, surface) };
           m.Triangles.append(ids, 3);
           m.TriangleComponent.push_back(n.Component);
         }
@@ -518,8 +491,8 @@ private:
     surface.ForEachTriangle(n.Node,
       [&](const SurfaceVertex* triangle)
       {
-        const std::int32_t ids[3] = { this->Vertex(work, n, triangle[0], st),
-          this->Vertex(work, n, triangle[1], st), this->Vertex(work, n, triangle[2], st) };
+        const std::int32_t ids[3] = { this->Vertex(work, n, triangle[0]),
+          this->Vertex(work, n, triangle[1]), this->Vertex(work, n, triangle[2]) };
         m.Triangles.append(ids, 3);
         m.TriangleComponent.push_back(n.Component);
       });
@@ -677,26 +650,16 @@ private:
         const std::int64_t base = vertexBase[c];
         for (std::int64_t v = 0; v < from.NumberOfPoints(); ++v)
         {
+          if (v + PrefetchAhead < from.NumberOfPoints())
+          {
+            this->PrefetchVertex(from.Keys[v + PrefetchAhead]);
+          }
           const std::int64_t to = chunk.FinalId[v];
           if (to < base)
           {
             continue; // the chunk below's vertex
           }
-          for (int a = 0; a < 3; ++a)
-          {
-            if (doublePoints)
-            {
-              m.PointsDouble[3 * to + a] = from.PointsDouble[3 * v + a];
-            }
-            else
-            {
-              m.Points[3 * to + a] = from.Points[3 * v + a];
-            }
-            if (normals)
-            {
-              m.Normals[3 * to + a] = from.Normals[3 * v + a];
-            }
-          }
+          this->PlaceVertex(from.Keys[v], to, doublePoints, normals);
           m.Keys[to] = from.Keys[v];
           m.VertexComponent[to] = from.VertexComponent[v];
         }
@@ -711,6 +674,51 @@ private:
         }
         chunk = Chunk();
       });
+  }
+
+  /// Asks the processor to fetch the samples that PlaceVertex reads for the vertex `key` (a
+  /// hint; it changes no result).
+  RGMC_INLINE void PrefetchVertex(std::int64_t key) const
+  {
+    int p[3], axis;
+    this->Volume.GridOf.Decode(key, p, axis);
+    this->Volume.PrefetchAround(p[0], p[1], p[2]);
+  }
+
+  /// The position and normal of the vertex `key` (vtkMarchingCubes' interpolation from the edge's
+  /// lower end, the gradients' central differences), stored as vertex `to` of the joined mesh.
+  RGMC_INLINE void PlaceVertex(std::int64_t key, std::int64_t to, bool doublePoints, bool normals)
+  {
+    SampledVolume<Values>& volume = this->Volume;
+    int p[3], axis;
+    volume.GridOf.Decode(key, p, axis);
+    double sLo = 0.0, sHi = 0.0;
+    if (axis >= 0)
+    {
+      int q[3] = { p[0], p[1], p[2] };
+      ++q[axis];
+      sLo = volume.Read(p[0], p[1], p[2]);
+      sHi = volume.Read(q[0], q[1], q[2]);
+    }
+    double x[3];
+    float normal[3] = { 0, 0, 0 };
+    volume.PositionAndNormal(p, axis, sLo, sHi, x, normal);
+    LocalMesh& m = this->Mesh;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (doublePoints)
+      {
+        m.PointsDouble[3 * to + a] = x[a];
+      }
+      else
+      {
+        m.Points[3 * to + a] = static_cast<float>(x[a]);
+      }
+      if (normals)
+      {
+        m.Normals[3 * to + a] = normal[a];
+      }
+    }
   }
 
   /// The components' totals: triangles and smallest key, on their roots.
