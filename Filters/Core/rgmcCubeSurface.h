@@ -82,6 +82,46 @@ struct SurfaceNode
   bool Degenerate;
 };
 
+/// Surface nodes in blocks, in order: growth hands over each tile's queue of a round as it is,
+/// instead of copying it onto the end of one growing list.
+class NodeList
+{
+public:
+  /// Appends the nodes of `block` (taken; left empty).
+  void Append(std::vector<SurfaceNode>& block)
+  {
+    if (!block.empty())
+    {
+      this->Count += block.size();
+      this->Blocks.emplace_back(std::move(block));
+    }
+    block = std::vector<SurfaceNode>();
+  }
+  std::size_t size() const { return this->Count; }
+  bool empty() const { return this->Count == 0; }
+  /// f(node) for every node, in order.
+  template <typename F>
+  void ForEach(F&& f) const
+  {
+    for (const std::vector<SurfaceNode>& block : this->Blocks)
+    {
+      for (const SurfaceNode& n : block)
+      {
+        f(n);
+      }
+    }
+  }
+  void Clear()
+  {
+    std::vector<std::vector<SurfaceNode>>().swap(this->Blocks);
+    this->Count = 0;
+  }
+
+private:
+  std::vector<std::vector<SurfaceNode>> Blocks;
+  std::size_t Count = 0;
+};
+
 /// The cube edge that runs along `axis` with its lower corner offset by du, dv (0 or 1) along
 /// the two other axes (in increasing axis order), from the corner and edge conventions.
 constexpr int CubeEdgeAt(int axis, int du, int dv)

@@ -137,13 +137,13 @@ public:
   /// components meet through cubes of another rank).
   std::int64_t Joins() const { return this->JoinCount; }
 
-  /// Makes the triangles of `nodes` (reordered by slab); fills Mesh, Ports and the components'
-  /// triangle counts and smallest keys. Slabs are cut into chunks of ChunkSlabs, extracted at
-  /// once (on threads) and joined in chunk order, so that the result does not depend on the
-  /// number of threads.
-  void Extract(std::vector<SurfaceNode>& nodes)
+  /// Makes the triangles of `found` (taken: left empty); fills Mesh, Ports and the components'
+  /// triangle counts and smallest keys. The nodes are sorted by slab, slabs are cut into chunks
+  /// of ChunkSlabs, extracted at once (on threads) and joined in chunk order, so that the result
+  /// does not depend on the number of threads.
+  void Extract(NodeList& found)
   {
-    if (nodes.empty() || this->Volume.Stopped())
+    if (found.empty() || this->Volume.Stopped())
     {
       return;
     }
@@ -155,37 +155,36 @@ public:
       box.Lo[a] = std::numeric_limits<int>::max();
       box.Hi[a] = std::numeric_limits<int>::min();
     }
-    for (const SurfaceNode& n : nodes)
-    {
-      const int c[3] = { n.I, n.J, n.K };
-      for (int a = 0; a < 3; ++a)
+    found.ForEach(
+      [&box](const SurfaceNode& n)
       {
-        box.Lo[a] = std::min(box.Lo[a], c[a]);
-        box.Hi[a] = std::max(box.Hi[a], c[a]);
-      }
-    }
+        const int c[3] = { n.I, n.J, n.K };
+        for (int a = 0; a < 3; ++a)
+        {
+          box.Lo[a] = std::min(box.Lo[a], c[a]);
+          box.Hi[a] = std::max(box.Hi[a], c[a]);
+        }
+      });
     const int numSlabs = box.Hi[2] - box.Lo[2] + 1;
 
     // Nodes by slab (a counting sort on k, keeping growth's order within a slab).
     std::vector<std::int64_t> start(static_cast<std::size_t>(numSlabs) + 1, 0);
     std::vector<std::int64_t> slabTriangles(static_cast<std::size_t>(numSlabs), 0);
-    for (const SurfaceNode& n : nodes)
-    {
-      ++start[n.K - box.Lo[2] + 1];
-      slabTriangles[n.K - box.Lo[2]] += this->Volume.Table[n.Case].NumTriangles;
-    }
+    found.ForEach(
+      [&](const SurfaceNode& n)
+      {
+        ++start[n.K - box.Lo[2] + 1];
+        slabTriangles[n.K - box.Lo[2]] += this->Volume.Table[n.Case].NumTriangles;
+      });
     for (int s = 0; s < numSlabs; ++s)
     {
       start[s + 1] += start[s];
     }
+    std::vector<SurfaceNode> nodes(found.size());
     {
       std::vector<std::int64_t> next(start.begin(), start.end() - 1);
-      std::vector<SurfaceNode> sorted(nodes.size());
-      for (const SurfaceNode& n : nodes)
-      {
-        sorted[next[n.K - box.Lo[2]]++] = n;
-      }
-      nodes.swap(sorted);
+      found.ForEach([&](const SurfaceNode& n) { nodes[next[n.K - box.Lo[2]]++] = n; });
+      found.Clear();
     }
     this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
     this->PlaneSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);

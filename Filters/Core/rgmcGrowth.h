@@ -75,7 +75,7 @@ public:
   }
 
   /// The nodes found: by round, then by tile, then in the order each tile found them.
-  std::vector<SurfaceNode>& Nodes() { return this->Found; }
+  NodeList& Nodes() { return this->Found; }
 
   /// Whether steps into cubes of other ranks are kept as departures (seeded growth on several
   /// ranks) instead of dropped.
@@ -185,12 +185,6 @@ public:
       return;
     }
     // Tile-local component labels become this rank's: tile by tile, in tile order.
-    std::size_t total = 0;
-    for (TileWork& w : this->Work)
-    {
-      total += w.Queue.size();
-    }
-    this->Found.reserve(this->Found.size() + total);
     for (std::int64_t tile = 0; tile < numTiles; ++tile)
     {
       const int first = this->Components.Size();
@@ -199,12 +193,11 @@ public:
         this->Components.Add(false);
       }
       TileWork& w = this->Work[tile];
-      for (SurfaceNode n : w.Queue)
+      for (SurfaceNode& n : w.Queue)
       {
         n.Component += first;
-        this->Found.push_back(n);
       }
-      w.Queue = std::vector<SurfaceNode>();
+      this->Found.Append(w.Queue);
     }
   }
 
@@ -579,13 +572,8 @@ private:
       for (const std::int64_t tile : active)
       {
         TileWork& w = this->Work[tile];
-        this->Found.insert(this->Found.end(), w.Queue.begin(), w.Queue.end());
         this->NodesExpanded += static_cast<std::int64_t>(w.Queue.size());
-        if (w.Queue.capacity() > 4096)
-        {
-          std::vector<SurfaceNode>().swap(w.Queue); // Found holds the nodes now
-        }
-        w.Queue.clear();
+        this->Found.Append(w.Queue); // the queue itself, not a copy
         for (const Crossing& c : w.Outbox)
         {
           const std::int64_t to = this->TileOf(c.I, c.J, c.K);
@@ -806,7 +794,7 @@ private:
   std::int64_t Tiles[3] = { 0, 0, 0 }; // tiles along each axis of the owned box
   ZeroedArray<std::uint64_t> Visited;  // a bit per owned cube: its nodes were all found
   std::vector<TileWork> Work;          // per tile
-  std::vector<SurfaceNode> Found;
+  NodeList Found;
   std::vector<Departure> Departures;
   std::vector<std::int64_t> Pending; // tiles with crossings left by the budget, sorted
   std::int64_t Budget = std::numeric_limits<std::int64_t>::max();

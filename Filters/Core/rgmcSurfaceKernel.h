@@ -92,7 +92,6 @@ public:
   std::vector<Port>& Ports() override { return this->Extraction.Ports; }
   ComponentSet& Components() override { return this->Found; }
   std::int64_t Joins() const { return this->Extraction.Joins(); }
-  std::int64_t NumberOfNodes() { return static_cast<std::int64_t>(this->Growth.Nodes().size()); }
 
   std::string Error() const override { return this->Volume.Error(); }
   bool Aborted() const override { return this->Volume.Aborted(); }

@@ -216,10 +216,8 @@ void CheckScan(const char* what, const int n[3], const std::vector<rgmc::CellBox
   growth.GrowAll();
   std::set<std::tuple<int, int, int, int>> found;
   std::size_t duplicates = 0;
-  for (const rgmc::SurfaceNode& node : growth.Nodes())
-  {
-    duplicates += !found.emplace(node.I, node.J, node.K, node.Node).second;
-  }
+  growth.Nodes().ForEach([&](const rgmc::SurfaceNode& node)
+    { duplicates += !found.emplace(node.I, node.J, node.K, node.Node).second; });
   std::set<std::tuple<int, int, int, int>> expected;
   rgmc::CubeSamples st;
   rgmc::CubeSurface surface;
