@@ -638,6 +638,16 @@ public:
     return true;
   }
 
+  /// What Describe needs of a surface node's cube: the case growth found and, for a cube with a
+  /// degenerate sample, its samples read again (the others need only their case). False when a
+  /// sample is NaN, as for Evaluate.
+  RGMC_INLINE bool NodeSamples(const SurfaceNode& n, CubeSamples& st)
+  {
+    st.Case = n.Case;
+    st.Degenerate = n.Degenerate;
+    return !n.Degenerate || this->Evaluate(n.I, n.J, n.K, st);
+  }
+
   /// Classifies the grid points (i0 + b, j, k), 0 <= b < n <= 64, as Evaluate would: bit b of
   /// `above` is set when the sample is at or above the isovalue, of `notNumber` when it is NaN
   /// (floating-point samples only). Reads each sample once, in memory order.

@@ -113,7 +113,8 @@ double PlaceCollapse(const Quadric& q, const double pa[3], const double pb[3], d
       const double e = q.Error(end);
       if (e < cost)
       {
-        cost = take(end);
+        std::copy(end, end + 3, position);
+        cost = e;
       }
     }
   }

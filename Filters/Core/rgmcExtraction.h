@@ -11,6 +11,7 @@
 #include "rgmcKeyMap.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -352,12 +353,8 @@ private:
             __builtin_prefetch(&layer->Ids[at + this->LayerNx]);
           }
         }
-        // A cube without a degenerate sample needs only its case (growth read its samples);
-        // a degenerate one is described from its samples again.
         const SurfaceNode& node = nodes[n];
-        st.Case = node.Case;
-        st.Degenerate = node.Degenerate;
-        if (!node.Degenerate || this->Volume.Evaluate(node.I, node.J, node.K, st))
+        if (this->Volume.NodeSamples(node, st))
         {
           this->Volume.Describe(node.I, node.J, node.K, st, surface);
           this->Emit(work, node, surface);
@@ -647,18 +644,33 @@ private:
         Chunk& chunk = chunks[c];
         const LocalMesh& from = chunk.Mesh;
         const std::int64_t base = vertexBase[c];
-        for (std::int64_t v = 0; v < from.NumberOfPoints(); ++v)
+        const std::int64_t nv = from.NumberOfPoints();
+        // Each key decoded once, PrefetchAhead vertices before its use, its samples prefetched
+        // then; the decoded edges wait in a ring.
+        std::array<EdgeOfKey, PrefetchAhead> ring;
+        auto decode = [&](std::int64_t v)
         {
-          if (v + PrefetchAhead < from.NumberOfPoints())
+          EdgeOfKey& e = ring[v % PrefetchAhead];
+          this->Volume.GridOf.Decode(from.Keys[v], e.P, e.Axis);
+          this->Volume.PrefetchAround(e.P[0], e.P[1], e.P[2]);
+        };
+        for (std::int64_t v = 0; v < std::min<std::int64_t>(PrefetchAhead, nv); ++v)
+        {
+          decode(v);
+        }
+        for (std::int64_t v = 0; v < nv; ++v)
+        {
+          const EdgeOfKey edge = ring[v % PrefetchAhead];
+          if (v + PrefetchAhead < nv)
           {
-            this->PrefetchVertex(from.Keys[v + PrefetchAhead]);
+            decode(v + PrefetchAhead);
           }
           const std::int64_t to = chunk.FinalId[v];
           if (to < base)
           {
             continue; // the chunk below's vertex
           }
-          this->PlaceVertex(from.Keys[v], to, doublePoints, normals);
+          this->PlaceVertex(edge, to, doublePoints, normals);
           m.Keys[to] = from.Keys[v];
           m.VertexComponent[to] = from.VertexComponent[v];
         }
@@ -675,22 +687,22 @@ private:
       });
   }
 
-  /// Asks the processor to fetch the samples that PlaceVertex reads for the vertex `key` (a
-  /// hint; it changes no result).
-  RGMC_INLINE void PrefetchVertex(std::int64_t key) const
+  /// A vertex's edge, decoded from its key: the grid point and the axis (-1 on a grid point).
+  struct EdgeOfKey
   {
-    int p[3], axis;
-    this->Volume.GridOf.Decode(key, p, axis);
-    this->Volume.PrefetchAround(p[0], p[1], p[2]);
-  }
+    int P[3];
+    int Axis;
+  };
 
-  /// The position and normal of the vertex `key` (vtkMarchingCubes' interpolation from the edge's
-  /// lower end, the gradients' central differences), stored as vertex `to` of the joined mesh.
-  RGMC_INLINE void PlaceVertex(std::int64_t key, std::int64_t to, bool doublePoints, bool normals)
+  /// The position and normal of the vertex on `edge` (vtkMarchingCubes' interpolation from the
+  /// edge's lower end, the gradients' central differences), stored as vertex `to` of the joined
+  /// mesh.
+  RGMC_INLINE void PlaceVertex(
+    const EdgeOfKey& edge, std::int64_t to, bool doublePoints, bool normals)
   {
     SampledVolume<Values>& volume = this->Volume;
-    int p[3], axis;
-    volume.GridOf.Decode(key, p, axis);
+    int p[3] = { edge.P[0], edge.P[1], edge.P[2] };
+    const int axis = edge.Axis;
     double sLo = 0.0, sHi = 0.0;
     if (axis >= 0)
     {

@@ -397,13 +397,10 @@ private:
     }
     TileWork& w = this->Work[tile];
     CubeSamples st;
-    if (n.Degenerate && !this->Volume.Evaluate(n.I, n.J, n.K, st))
+    if (!this->Volume.NodeSamples(n, st))
     {
       return;
     }
-    // A cube without a degenerate sample needs only its case.
-    st.Case = n.Case;
-    st.Degenerate = n.Degenerate;
     CubeSurface surface;
     this->Volume.Describe(n.I, n.J, n.K, st, surface);
     const Ownership& own = this->Volume.Owned;
