@@ -11,8 +11,8 @@
 #include "vtkRGRunController.h"
 #include "vtkRGSeamRepair.h"
 
+#include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
-#include "vtkCellArrayIterator.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
@@ -169,9 +169,9 @@ public:
     return at != this->Vertices.end() && at->Id == id ? at - this->Vertices.begin() : -1;
   }
 
-  /// Sorts by id and keeps one of each (copies of a vertex are equal). The first `sortedPrefix`
-  /// are sorted already; when the rest is too (what came from one rank), the two are merged.
-  void SortUnique(std::size_t sortedPrefix = 0)
+  /// Sorts by id and keeps one of each (copies of a vertex are equal: decimation never
+  /// touches a vertex that more than one block has). In place: the records are not held twice.
+  void SortUnique()
   {
     const std::size_t n = this->Vertices.size();
     std::vector<std::pair<vtkIdType, std::size_t>> order(n);
@@ -179,33 +179,53 @@ public:
     {
       order[i] = { this->Vertices[i].Id, i };
     }
-    const auto tail = order.begin() + static_cast<std::ptrdiff_t>(sortedPrefix);
-    if (std::is_sorted(tail, order.end()))
-    {
-      std::inplace_merge(order.begin(), tail, order.end());
-    }
-    else
-    {
-      rgmc::RadixSort(
-        order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); });
-    }
-    std::vector<Vertex> vertices;
-    std::vector<rgmc::Quadric> quadrics;
-    vertices.reserve(n);
-    quadrics.reserve(this->HasQuadrics ? n : 0);
+    rgmc::RadixSort(
+      order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); });
+    // Record i becomes record order[i].second: each cycle of the permutation walked once, its
+    // places marked done by pointing them at themselves.
     for (std::size_t i = 0; i < n; ++i)
     {
-      if (i == 0 || order[i].first != order[i - 1].first)
+      if (order[i].second == i)
       {
-        vertices.push_back(this->Vertices[order[i].second]);
+        continue;
+      }
+      const Vertex vertex = this->Vertices[i];
+      const rgmc::Quadric quadric = this->HasQuadrics ? this->Quadrics[i] : rgmc::Quadric();
+      std::size_t at = i;
+      while (order[at].second != i)
+      {
+        const std::size_t from = order[at].second;
+        this->Vertices[at] = this->Vertices[from];
         if (this->HasQuadrics)
         {
-          quadrics.push_back(this->Quadrics[order[i].second]);
+          this->Quadrics[at] = this->Quadrics[from];
         }
+        order[at].second = at;
+        at = from;
+      }
+      this->Vertices[at] = vertex;
+      if (this->HasQuadrics)
+      {
+        this->Quadrics[at] = quadric;
+      }
+      order[at].second = at;
+    }
+    std::vector<std::pair<vtkIdType, std::size_t>>().swap(order);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (kept == 0 || this->Vertices[i].Id != this->Vertices[kept - 1].Id)
+      {
+        this->Vertices[kept] = this->Vertices[i];
+        if (this->HasQuadrics)
+        {
+          this->Quadrics[kept] = this->Quadrics[i];
+        }
+        ++kept;
       }
     }
-    this->Vertices.swap(vertices);
-    this->Quadrics.swap(quadrics);
+    this->Vertices.resize(kept);
+    this->Quadrics.resize(this->HasQuadrics ? kept : 0);
   }
 
   void Clear()
@@ -236,14 +256,208 @@ struct Grid
   }
 };
 
+/// This rank's part of the surface at the start of a pass: its triangles as indices of its
+/// vertices, and the vertices' global ids, positions and (after the first pass) quadrics. The
+/// first pass reads the input where it is (its connectivity, global ids and points): a copy
+/// would hold the whole surface twice while the blocks are made. The input may hold copies of a
+/// vertex (the same id and position at several points); the blocks see each id once.
+class SurfacePart
+{
+public:
+  /// The input's triangles (every cell is one: CheckInput) and points, in place.
+  void Read(vtkPolyData* input)
+  {
+    this->Clear();
+    this->Input = input;
+    vtkCellArray* polys = input->GetPolys();
+    this->InputTriangles = static_cast<std::size_t>(polys->GetNumberOfCells());
+    vtkDataArray* connectivity = polys->GetConnectivityArray();
+    if (auto* ids = vtkAOSDataArrayTemplate<vtkIdType>::FastDownCast(connectivity))
+    {
+      this->Corner64 = ids->GetPointer(0);
+    }
+    else if (auto* ids32 = vtkAOSDataArrayTemplate<std::int32_t>::FastDownCast(connectivity))
+    {
+      this->Corner32 = ids32->GetPointer(0);
+    }
+    else
+    {
+      this->CornerCopy.reserve(3 * this->InputTriangles);
+      vtkIdType npts;
+      const vtkIdType* pts;
+      for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+      {
+        this->CornerCopy.insert(this->CornerCopy.end(), pts, pts + 3);
+      }
+      this->Corner64 = this->CornerCopy.data();
+    }
+    // No global ids only where there are no points (CheckInput).
+    auto* ids = vtkIdTypeArray::SafeDownCast(input->GetPointData()->GetGlobalIds());
+    this->GlobalIds = ids ? ids->GetPointer(0) : nullptr;
+    vtkDataArray* points = input->GetPoints() ? input->GetPoints()->GetData() : nullptr;
+    if (auto* d = vtkAOSDataArrayTemplate<double>::FastDownCast(points))
+    {
+      this->PointsDouble = d->GetPointer(0);
+    }
+    else if (auto* f = vtkAOSDataArrayTemplate<float>::FastDownCast(points))
+    {
+      this->PointsFloat = f->GetPointer(0);
+    }
+  }
+
+  /// Takes the triangles (by global ids) and their vertices' records as the part's own: the
+  /// records sorted by id with copies merged, the triangles turned into indices of them.
+  void Adopt(std::vector<Triangle>& byId, VertexTable& vertices)
+  {
+    this->Clear();
+    std::swap(this->Vertices, vertices);
+    this->Vertices.SortUnique();
+    if (this->Vertices.Vertices.size() > static_cast<std::size_t>(VTK_INT_MAX))
+    {
+      throw std::runtime_error("a rank's part of the surface has more than 2^31 vertices");
+    }
+    this->Triangles.resize(byId.size());
+    for (std::size_t t = 0; t < byId.size(); ++t)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        this->Triangles[t][k] = static_cast<std::int32_t>(this->Vertices.Find(byId[t][k]));
+      }
+    }
+    std::vector<Triangle>().swap(byId);
+  }
+
+  /// Makes an input part the part's own (as Adopt would have it).
+  void OwnInput()
+  {
+    if (!this->Input)
+    {
+      return;
+    }
+    std::vector<Triangle> byId(this->NumberOfTriangles());
+    VertexTable vertices;
+    std::vector<char> used(this->NumberOfVertices(), 0);
+    for (std::size_t t = 0; t < byId.size(); ++t)
+    {
+      vtkIdType c[3];
+      this->Corners(t, c);
+      for (int k = 0; k < 3; ++k)
+      {
+        byId[t][k] = this->Id(c[k]);
+        used[c[k]] = 1;
+      }
+    }
+    for (std::size_t v = 0; v < used.size(); ++v)
+    {
+      if (used[v])
+      {
+        Vertex record;
+        record.Id = this->Id(static_cast<vtkIdType>(v));
+        this->Point(static_cast<vtkIdType>(v), record.Point);
+        vertices.Add(record, nullptr);
+      }
+    }
+    this->Adopt(byId, vertices);
+  }
+
+  std::size_t NumberOfTriangles() const
+  {
+    return this->Input ? this->InputTriangles : this->Triangles.size();
+  }
+  std::size_t NumberOfVertices() const
+  {
+    return this->Input ? static_cast<std::size_t>(this->Input->GetNumberOfPoints())
+                       : this->Vertices.Vertices.size();
+  }
+  bool HasQuadrics() const { return !this->Input && this->Vertices.HasQuadrics; }
+
+  /// The vertices of triangle `t`, as indices of the part's vertices.
+  void Corners(std::size_t t, vtkIdType c[3]) const
+  {
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      c[k] = !this->Input ? static_cast<vtkIdType>(this->Triangles[t][k])
+        : this->Corner64  ? this->Corner64[3 * t + k]
+                          : static_cast<vtkIdType>(this->Corner32[3 * t + k]);
+    }
+  }
+  vtkIdType Id(vtkIdType v) const
+  {
+    return this->Input ? this->GlobalIds[v] : this->Vertices.Vertices[v].Id;
+  }
+  void Point(vtkIdType v, double p[3]) const
+  {
+    if (!this->Input)
+    {
+      std::copy(this->Vertices.Vertices[v].Point, this->Vertices.Vertices[v].Point + 3, p);
+    }
+    else if (this->PointsDouble)
+    {
+      std::copy(this->PointsDouble + 3 * v, this->PointsDouble + 3 * v + 3, p);
+    }
+    else if (this->PointsFloat)
+    {
+      std::copy(this->PointsFloat + 3 * v, this->PointsFloat + 3 * v + 3, p);
+    }
+    else
+    {
+      this->Input->GetPoint(v, p);
+    }
+  }
+  /// Message words of vertex `v`: id and position, then its quadric's 10 terms if it has one.
+  void Write(vtkIdType v, std::vector<vtkIdType>& words) const
+  {
+    if (!this->Input)
+    {
+      this->Vertices.Write(static_cast<std::size_t>(v), words);
+      return;
+    }
+    double p[3];
+    this->Point(v, p);
+    words.push_back(this->Id(v));
+    for (double x : p)
+    {
+      words.push_back(rgmc::WordOf(x));
+    }
+  }
+
+  void Clear()
+  {
+    this->Input = nullptr;
+    this->Corner64 = nullptr;
+    this->Corner32 = nullptr;
+    std::vector<vtkIdType>().swap(this->CornerCopy);
+    this->PointsDouble = nullptr;
+    this->PointsFloat = nullptr;
+    std::vector<std::array<std::int32_t, 3>>().swap(this->Triangles);
+    this->Vertices.Clear();
+  }
+
+  std::vector<std::array<std::int32_t, 3>> Triangles; // the part's own: indices of Vertices
+  VertexTable Vertices;                               // the part's own: by increasing id
+
+private:
+  vtkPolyData* Input = nullptr; // the first pass: the input, in place
+  std::size_t InputTriangles = 0;
+  const vtkIdType* Corner64 = nullptr;
+  const std::int32_t* Corner32 = nullptr;
+  std::vector<vtkIdType> CornerCopy; // when the input's connectivity is of another type
+  const vtkIdType* GlobalIds = nullptr;
+  const double* PointsDouble = nullptr;
+  const float* PointsFloat = nullptr;
+};
+
 /// One block on its rank during a pass.
 struct Block
 {
   vtkIdType Id;
-  std::vector<Triangle> Own, Halo;
-  std::vector<std::pair<vtkIdType, vtkIdType>> SharedWith; // (vertex, other block), sorted
+  int Wave = 0;
+  std::vector<Triangle> Own, Halo; // by global ids, as they came
   rgmc::DecimationBlock Mesh;
   std::vector<rgmc::Collapse> Log;
+  std::vector<double> Levels; // of the collapses in Log (non-decreasing)
+  std::size_t Vertices = 0;   // of its own triangles
+  std::size_t Fixed = 0;      // of those, the ones it shares with other blocks
   std::size_t Keep = 0;
 };
 
@@ -252,42 +466,58 @@ std::vector<bool> Everyone(int size)
   return std::vector<bool>(static_cast<std::size_t>(size), true);
 }
 
-/// A message of triangles for blocks: their count, (block, three vertex ids) for each of the
-/// `count` that `each(i, block)` gives, then the records of their vertices from `table`, each
-/// once, by increasing id.
-template <typename Each>
+/// A triangle of this rank's part going to a block: (block, triangle, 1 if to its halo).
+using Sending = std::array<vtkIdType, 3>;
+
+/// A message of triangles for blocks: the counts of own and halo triangles, (block, three
+/// vertex ids) for each (the own ones first), then the records of their vertices, each once, by
+/// increasing id.
 void WriteTriangles(
-  std::vector<vtkIdType>& words, std::size_t count, const VertexTable& table, Each&& each)
+  std::vector<vtkIdType>& words, std::vector<Sending>& going, const SurfacePart& part)
 {
-  std::vector<vtkIdType> ids;
-  words.push_back(static_cast<vtkIdType>(count));
-  for (std::size_t i = 0; i < count; ++i)
+  std::stable_partition(going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; });
+  const auto halos =
+    std::count_if(going.begin(), going.end(), [](const Sending& s) { return s[2]; });
+  words.reserve(2 + 4 * going.size() + 3 * going.size() * (part.HasQuadrics() ? 14 : 4) / 2);
+  words.push_back(static_cast<vtkIdType>(going.size()) - halos);
+  words.push_back(halos);
+  std::vector<std::pair<vtkIdType, vtkIdType>> vertices; // (id, index in the part)
+  vertices.reserve(3 * going.size());
+  for (const Sending& s : going)
   {
-    vtkIdType block;
-    const Triangle& t = each(i, block);
-    words.push_back(block);
-    words.insert(words.end(), t.begin(), t.end());
-    ids.insert(ids.end(), t.begin(), t.end());
+    vtkIdType c[3];
+    part.Corners(static_cast<std::size_t>(s[1]), c);
+    words.push_back(s[0]);
+    for (vtkIdType v : c)
+    {
+      const vtkIdType id = part.Id(v);
+      words.push_back(id);
+      vertices.emplace_back(id, v);
+    }
   }
-  SortDistinct(ids);
-  for (vtkIdType id : ids)
+  rgmc::RadixSort(
+    vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); });
+  for (std::size_t i = 0; i < vertices.size(); ++i)
   {
-    table.Write(table.Find(id), words);
+    if (i == 0 || vertices[i].first != vertices[i - 1].first)
+    {
+      part.Write(vertices[i].second, words);
+    }
   }
 }
 
-/// Reads what WriteTriangles wrote: each triangle into `list` of its block (`blockWithId`; one
-/// this rank does not own is an error), the vertex records into `table`.
+/// Reads what WriteTriangles wrote: each triangle into its block's own or halo list
+/// (`blockWithId`; a block this rank does not own is an error), the vertex records into `table`.
 template <typename BlockWithId>
-void ReadTriangles(const std::vector<vtkIdType>& words, std::vector<Triangle> Block::*list,
-  BlockWithId&& blockWithId, VertexTable& table)
+void ReadTriangles(
+  const std::vector<vtkIdType>& words, BlockWithId&& blockWithId, VertexTable& table)
 {
-  if (words.empty())
+  if (words.size() < 2)
   {
     return;
   }
-  const vtkIdType n = words[0];
-  std::size_t at = 1;
+  const vtkIdType own = words[0], n = words[0] + words[1];
+  std::size_t at = 2;
   for (vtkIdType t = 0; t < n; ++t, at += 4)
   {
     Block* block = blockWithId(words[at]);
@@ -295,7 +525,7 @@ void ReadTriangles(const std::vector<vtkIdType>& words, std::vector<Triangle> Bl
     {
       throw std::runtime_error("triangles came to a rank that does not own their block");
     }
-    (block->*list).push_back({ words[at + 1], words[at + 2], words[at + 3] });
+    (t < own ? block->Own : block->Halo).push_back({ words[at + 1], words[at + 2], words[at + 3] });
   }
   const std::size_t size = table.Words();
   for (; at + size <= words.size(); at += size)
@@ -334,18 +564,19 @@ struct vtkRGDecimate::Run
   vtkIdType triangles = 0;      // now, over all ranks
   vtkIdType target = 0;         // the triangles to keep
   double lower[3], upper[3];    // the global bounds
-  // This rank's part of the surface between passes: triangles by global ids (in their cyclic
-  // order) and their vertices.
-  std::vector<Triangle> surface;
-  VertexTable vertices;
-  bool quadrics = false; // whether the vertices carry their quadrics yet
+  SurfacePart part;             // this rank's part of the surface at the start of the pass
   Grid grid;
   std::vector<vtkIdType> blockTriangles; // per block of the grid, over all ranks
   std::vector<int> owner;                // per block
-  std::vector<vtkIdType> surfaceBlock;   // the block of each of this rank's triangles
-  std::vector<Block> blocks;             // this rank's, by increasing id
-  VertexTable seen;                      // the vertices of its blocks' triangles and halos
-  vtkIdType collapses = 0;               // made in the last pass, over all ranks
+  std::vector<int> waveOf;               // per block: the wave of its rank's blocks it is in
+  int waves = 1;                         // on every rank, the same number
+  std::vector<std::int32_t> partBlock;   // the block of each of the part's triangles
+  // The part's vertices in several blocks: (vertex, block) for each of their blocks, sorted,
+  // and a flag per vertex.
+  std::vector<std::pair<vtkIdType, vtkIdType>> shared;
+  std::vector<std::uint8_t> isShared;
+  std::vector<Block> blocks; // this rank's, by increasing id, so by wave
+  vtkIdType collapses = 0;   // made in the last pass, over all ranks
   int passes = 0;
   double maximumLevel = 0; // the largest quadric error kept, over all ranks
 
@@ -366,15 +597,18 @@ struct vtkRGDecimate::Run
 //                             agreement
 //  then, for each of up to 16 passes while the target is not reached and collapses are made:
 //  PASS 2 PlaceBlocks         agreement, AllReduce (triangles per block), agreement
-//  PASS 3 SendTriangles       agreement, exchange, agreement
-//  PASS 4 FindSharedVertices  agreement, exchange, agreement, exchange, agreement
-//  PASS 5 SendHalos           agreement, exchange, agreement
-//  PASS 6 SimplifyBlocks      agreement
-//  PASS 7 KeepCheapest        AllReduce (collapses found, free and fixed vertices); when more
+//  PASS 3 FindSharedVertices  agreement, exchange, agreement, exchange, agreement
+//  then for each wave (one, or as many as PlaceBlocks sets, the same number on every rank):
+//  PASS 4 SendTriangles       agreement, exchange, agreement
+//  PASS 5 SimplifyBlocks      agreement
+//  then:
+//  PASS 6 KeepCheapest        AllReduce (collapses found, free and fixed vertices); when more
 //                             are found than needed, one AllReduce per bisection step (the
 //                             same number on every rank: they see the same sums) and an
-//                             AllGather; agreement; AllReduce (triangles, collapses);
-//                             AllReduce (error); agreement
+//                             AllGather
+//  PASS 7 ApplyCollapses      with one wave: agreement; with several, for each wave
+//                             SendTriangles's schedule, then agreement; then agreement,
+//                             AllReduce (triangles, collapses), AllReduce (error), agreement
 //  PASS 8 NumberSurface       agreement; vtkRGSeamRepair's own schedule (no smoothing)
 int vtkRGDecimate::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
@@ -397,7 +631,7 @@ int vtkRGDecimate::RequestData(
     return 0;
   };
 
-  // PASS 0-1: a numbered triangle mesh, read into global ids and positions.
+  // PASS 0-1: a numbered triangle mesh, read in place.
   if (!this->CheckInput(run) || !this->ReadSurface(run))
   {
     return fail();
@@ -405,10 +639,23 @@ int vtkRGDecimate::RequestData(
   this->UpdateProgress(0.05);
   for (int pass = 0; pass < Passes && run.triangles > run.target; ++pass)
   {
-    // PASS 2-7: one pass of block simplification.
-    if (!this->PlaceBlocks(run, pass) || !this->SendTriangles(run) ||
-      !this->FindSharedVertices(run) || !this->SendHalos(run) || !this->SimplifyBlocks(run) ||
-      !this->KeepCheapest(run, pass >= AllFromPass))
+    // PASS 2-7: one pass of block simplification, its blocks made and simplified in waves.
+    if (!this->PlaceBlocks(run, pass) || !this->FindSharedVertices(run))
+    {
+      return fail();
+    }
+    for (int wave = 0; wave < run.waves; ++wave)
+    {
+      if (!this->SendTriangles(run, wave) || !this->SimplifyBlocks(run, wave))
+      {
+        return fail();
+      }
+      if (run.waves > 1)
+      {
+        ReleaseFreeMemory(); // the wave's meshes and messages
+      }
+    }
+    if (!this->KeepCheapest(run, pass >= AllFromPass) || !this->ApplyCollapses(run))
     {
       return fail();
     }
@@ -492,53 +739,42 @@ bool vtkRGDecimate::CheckInput(Run& run)
 //------------------------------------------------------------------------------
 bool vtkRGDecimate::ReadSurface(Run& run)
 {
-  vtkPolyData* input = run.input;
+  double mine[6] = { VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX,
+    VTK_DOUBLE_MAX };
   if (!run.ranks.Step("read the surface", run.problem,
         [&]()
         {
-          vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(input->GetPointData()->GetGlobalIds());
-          vtkCellArray* polys = input->GetPolys();
-          run.surface.reserve(static_cast<std::size_t>(polys->GetNumberOfCells()));
-          std::vector<char> used(static_cast<std::size_t>(input->GetNumberOfPoints()), 0);
-          auto it = vtk::TakeSmartPointer(polys->NewIterator());
-          for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+          SurfacePart& part = run.part;
+          part.Read(run.input);
+          std::vector<char> used(part.NumberOfVertices(), 0);
+          for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
           {
-            vtkIdType size;
-            const vtkIdType* pts;
-            it->GetCurrentCell(size, pts);
-            run.surface.push_back(
-              { ids->GetValue(pts[0]), ids->GetValue(pts[1]), ids->GetValue(pts[2]) });
-            used[pts[0]] = used[pts[1]] = used[pts[2]] = 1;
+            vtkIdType c[3];
+            part.Corners(t, c);
+            used[c[0]] = used[c[1]] = used[c[2]] = 1;
           }
-          for (vtkIdType p = 0; p < input->GetNumberOfPoints(); ++p)
+          // The bounds of the triangles' vertices, in one reduction: the maxima as negated
+          // minima.
+          for (std::size_t v = 0; v < used.size(); ++v)
           {
-            if (used[p])
+            if (used[v])
             {
-              Vertex v;
-              v.Id = ids->GetValue(p);
-              input->GetPoint(p, v.Point);
-              run.vertices.Add(v, nullptr);
+              double p[3];
+              part.Point(static_cast<vtkIdType>(v), p);
+              for (int a = 0; a < 3; ++a)
+              {
+                mine[a] = std::min(mine[a], p[a]);
+                mine[3 + a] = std::min(mine[3 + a], -p[a]);
+              }
             }
           }
-          run.vertices.SortUnique();
         }))
   {
     return false;
   }
-  double mine[6] = { VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX,
-    VTK_DOUBLE_MAX };
-  for (const Vertex& v : run.vertices.Vertices)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      mine[a] = std::min(mine[a], v.Point[a]);
-      mine[3 + a] = std::min(mine[3 + a], -v.Point[a]);
-    }
-  }
-  // The bounds in one reduction: the maxima as negated minima.
   double all[6];
   run.ranks.AllReduce(mine, all, 6, vtkCommunicator::MIN_OP, "reducing the bounds");
-  const vtkIdType local = static_cast<vtkIdType>(run.surface.size());
+  const vtkIdType local = static_cast<vtkIdType>(run.part.NumberOfTriangles());
   run.ranks.AllReduce(
     &local, &run.inputTriangles, 1, vtkCommunicator::SUM_OP, "counting the triangles");
   for (int a = 0; a < 3; ++a)
@@ -558,7 +794,7 @@ bool vtkRGDecimate::ReadSurface(Run& run)
 
 //------------------------------------------------------------------------------
 // The grid (from the global bounds and triangle count, the same in every pass but for its
-// offset), the triangles of each block over all ranks, and the blocks' ranks.
+// offset), the triangles of each block over all ranks, the blocks' ranks and waves.
 bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
 {
   Grid& grid = run.grid;
@@ -581,15 +817,22 @@ bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
   if (!run.ranks.Step("count the triangles of the blocks", run.problem,
         [&]()
         {
+          const SurfacePart& part = run.part;
           mine.assign(static_cast<std::size_t>(grid.Count()), 0);
-          run.surfaceBlock.resize(run.surface.size());
-          for (std::size_t t = 0; t < run.surface.size(); ++t)
+          run.partBlock.resize(part.NumberOfTriangles());
+          for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
           {
-            const Triangle& tri = run.surface[t];
-            const vtkIdType lowest = std::min({ tri[0], tri[1], tri[2] });
-            run.surfaceBlock[t] =
-              grid.BlockOf(run.vertices.Vertices[run.vertices.Find(lowest)].Point);
-            ++mine[run.surfaceBlock[t]];
+            vtkIdType c[3];
+            part.Corners(t, c);
+            vtkIdType lowest = c[0];
+            for (int k = 1; k < 3; ++k)
+            {
+              lowest = part.Id(c[k]) < part.Id(lowest) ? c[k] : lowest;
+            }
+            double p[3];
+            part.Point(lowest, p);
+            run.partBlock[t] = static_cast<std::int32_t>(grid.BlockOf(p));
+            ++mine[run.partBlock[t]];
           }
           run.blockTriangles.assign(mine.size(), 0);
         }))
@@ -601,129 +844,146 @@ bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
   // Contiguous ranges of blocks, of about equal triangle counts, rank after rank: the blocks'
   // order is then the ranks' order, and the output's triangles are in block order whatever
   // the number of ranks.
+  const int size = run.ranks.Size;
   run.owner.assign(run.blockTriangles.size(), 0);
-  run.blocks.clear();
+  std::vector<vtkIdType> ofRank(static_cast<std::size_t>(size), 0);
   vtkIdType before = 0;
   const vtkIdType total = std::max<vtkIdType>(1, run.triangles);
   for (std::size_t b = 0; b < run.blockTriangles.size(); ++b)
   {
     const vtkIdType count = run.blockTriangles[b];
-    run.owner[b] = static_cast<int>(
-      std::min<vtkIdType>(run.ranks.Size - 1, (2 * before + count) * run.ranks.Size / (2 * total)));
+    run.owner[b] =
+      static_cast<int>(std::min<vtkIdType>(size - 1, (2 * before + count) * size / (2 * total)));
     before += count;
-    if (count > 0 && run.owner[b] == run.ranks.Rank)
+    ofRank[run.owner[b]] += count;
+  }
+  // Waves: a rank whose blocks hold more than TrianglesPerWave triangles makes them in waves
+  // of contiguous blocks, at least 16, so that it holds one wave's blocks at a time. Every rank
+  // computes the same number from the global counts; it never changes the result.
+  const vtkIdType largest = *std::max_element(ofRank.begin(), ofRank.end());
+  run.waves = largest <= this->TrianglesPerWave
+    ? 1
+    : static_cast<int>(
+        std::max<vtkIdType>(16, (largest + this->TrianglesPerWave - 1) / this->TrianglesPerWave));
+  run.waveOf.assign(run.blockTriangles.size(), 0);
+  std::vector<vtkIdType> earlier(static_cast<std::size_t>(size), 0);
+  run.blocks.clear();
+  for (std::size_t b = 0; b < run.blockTriangles.size(); ++b)
+  {
+    const int r = run.owner[b];
+    const vtkIdType count = run.blockTriangles[b];
+    run.waveOf[b] = static_cast<int>(std::min<vtkIdType>(run.waves - 1,
+      (2 * earlier[r] + count) * run.waves / (2 * std::max<vtkIdType>(1, ofRank[r]))));
+    earlier[r] += count;
+    if (count > 0 && r == run.ranks.Rank)
     {
       run.blocks.emplace_back();
       run.blocks.back().Id = static_cast<vtkIdType>(b);
+      run.blocks.back().Wave = run.waveOf[b];
     }
   }
   return run.ranks.Agree(run.problem.empty(), run.problem);
 }
 
 //------------------------------------------------------------------------------
-// Each triangle, with its vertices, to the rank of its block.
-bool vtkRGDecimate::SendTriangles(Run& run)
-{
-  const int size = run.ranks.Size;
-  std::vector<std::vector<vtkIdType>> outgoing(static_cast<std::size_t>(size));
-  if (!run.ranks.Step("send the triangles to their blocks", run.problem,
-        [&]()
-        {
-          std::vector<std::vector<std::size_t>> going(static_cast<std::size_t>(size));
-          for (std::size_t t = 0; t < run.surface.size(); ++t)
-          {
-            going[run.owner[run.surfaceBlock[t]]].push_back(t);
-          }
-          for (int r = 0; r < size; ++r)
-          {
-            WriteTriangles(outgoing[r], going[r].size(), run.vertices,
-              [&](std::size_t i, vtkIdType& block) -> const Triangle&
-              {
-                block = run.surfaceBlock[going[r][i]];
-                return run.surface[going[r][i]];
-              });
-          }
-          std::vector<Triangle>().swap(run.surface);
-          std::vector<vtkIdType>().swap(run.surfaceBlock);
-          run.vertices.Clear();
-        }))
-  {
-    return false;
-  }
-  auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), TrianglesTag);
-  return run.ranks.Step("receive the blocks' triangles", run.problem,
-    [&]()
-    {
-      run.seen.Clear();
-      run.seen.HasQuadrics = run.quadrics;
-      for (auto& words : incoming)
-      {
-        ReadTriangles(
-          words, &Block::Own, [&run](vtkIdType id) { return run.BlockWithId(id); }, run.seen);
-        std::vector<vtkIdType>().swap(words); // read: its memory goes back at once
-      }
-    });
-}
-
-//------------------------------------------------------------------------------
-// The vertices each block shares with others: (vertex, block) pairs meet at the vertex's rank,
-// which tells each block the other blocks of the vertex.
+// The part's vertices that lie in several blocks, with all their blocks: (vertex, block) pairs
+// meet at the vertex's rank (its id modulo the ranks), which tells each rank that sent one the
+// blocks of each vertex in more than one.
 bool vtkRGDecimate::FindSharedVertices(Run& run)
 {
   const int size = run.ranks.Size;
   std::vector<std::vector<vtkIdType>> outgoing(static_cast<std::size_t>(size));
-  if (!run.ranks.Step("list the blocks' vertices", run.problem,
+  if (!run.ranks.Step("list the vertices' blocks", run.problem,
         [&]()
         {
-          for (const Block& block : run.blocks)
+          const SurfacePart& part = run.part;
+          const std::size_t nv = part.NumberOfVertices();
+          // Each vertex's first block, and its other blocks apart (few vertices have any).
+          std::vector<std::int32_t> first(nv, -1);
+          std::vector<std::pair<vtkIdType, vtkIdType>> more;
+          for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
           {
-            std::vector<vtkIdType> ids;
-            for (const Triangle& t : block.Own)
+            vtkIdType c[3];
+            part.Corners(t, c);
+            for (vtkIdType v : c)
             {
-              ids.insert(ids.end(), t.begin(), t.end());
+              if (first[v] < 0)
+              {
+                first[v] = run.partBlock[t];
+              }
+              else if (first[v] != run.partBlock[t])
+              {
+                more.emplace_back(v, run.partBlock[t]);
+              }
             }
-            SortDistinct(ids);
-            for (vtkIdType id : ids)
+          }
+          std::sort(more.begin(), more.end());
+          more.erase(std::unique(more.begin(), more.end()), more.end());
+          auto send = [&](vtkIdType v, vtkIdType block)
+          {
+            const vtkIdType id = part.Id(v);
+            auto& words = outgoing[static_cast<std::size_t>(id % size)];
+            words.push_back(id);
+            words.push_back(v);
+            words.push_back(block);
+          };
+          for (std::size_t v = 0; v < nv; ++v)
+          {
+            if (first[v] >= 0)
             {
-              auto& words = outgoing[static_cast<std::size_t>(id % size)];
-              words.push_back(id);
-              words.push_back(block.Id);
+              send(static_cast<vtkIdType>(v), first[v]);
             }
+          }
+          for (const auto& vb : more)
+          {
+            send(vb.first, vb.second);
           }
         }))
   {
     return false;
   }
-  const auto pairs = run.ranks.Exchange(std::move(outgoing), Everyone(size), SharedTag);
+  auto asked = run.ranks.Exchange(std::move(outgoing), Everyone(size), SharedTag);
   std::vector<std::vector<vtkIdType>> answers(static_cast<std::size_t>(size));
   if (!run.ranks.Step("find the shared vertices", run.problem,
         [&]()
         {
-          std::vector<std::pair<vtkIdType, vtkIdType>> all; // (vertex, block)
-          for (const auto& words : pairs)
+          // (vertex id, block, asking rank, its index of the vertex)
+          std::vector<std::array<vtkIdType, 4>> all;
+          for (int r = 0; r < size; ++r)
           {
-            for (std::size_t at = 0; at + 1 < words.size(); at += 2)
+            const auto& words = asked[r];
+            for (std::size_t at = 0; at + 2 < words.size(); at += 3)
             {
-              all.emplace_back(words[at], words[at + 1]);
+              all.push_back({ words[at], words[at + 2], r, words[at + 1] });
             }
+            std::vector<vtkIdType>().swap(asked[r]);
           }
-          std::sort(all.begin(), all.end());
+          rgmc::RadixSort(all, [](const std::array<vtkIdType, 4>& e) { return KeyOf(e[0]); });
+          std::vector<vtkIdType> blocks;
+          std::vector<std::pair<vtkIdType, vtkIdType>> askers;
           for (std::size_t first = 0, last; first < all.size(); first = last)
           {
-            for (last = first + 1; last < all.size() && all[last].first == all[first].first; ++last)
+            blocks.clear();
+            askers.clear();
+            for (last = first; last < all.size() && all[last][0] == all[first][0]; ++last)
             {
+              blocks.push_back(all[last][1]);
+              askers.emplace_back(all[last][2], all[last][3]);
             }
-            for (std::size_t i = first; last - first > 1 && i < last; ++i)
+            SortDistinct(blocks);
+            if (blocks.size() < 2)
             {
-              auto& words = answers[run.owner[all[i].second]];
-              for (std::size_t j = first; j < last; ++j)
+              continue;
+            }
+            std::sort(askers.begin(), askers.end());
+            askers.erase(std::unique(askers.begin(), askers.end()), askers.end());
+            for (const auto& asker : askers)
+            {
+              auto& words = answers[asker.first];
+              for (vtkIdType block : blocks)
               {
-                if (j != i)
-                {
-                  words.push_back(all[i].second);
-                  words.push_back(all[i].first);
-                  words.push_back(all[j].second);
-                }
+                words.push_back(asker.second);
+                words.push_back(block);
               }
             }
           }
@@ -735,101 +995,106 @@ bool vtkRGDecimate::FindSharedVertices(Run& run)
   return run.ranks.Step("record the shared vertices", run.problem,
     [&]()
     {
+      run.shared.clear();
       for (const auto& words : told)
       {
-        for (std::size_t at = 0; at + 2 < words.size(); at += 3)
+        for (std::size_t at = 0; at + 1 < words.size(); at += 2)
         {
-          Block* block = run.BlockWithId(words[at]);
-          if (!block)
-          {
-            throw std::runtime_error("a shared vertex was reported to the wrong rank");
-          }
-          block->SharedWith.emplace_back(words[at + 1], words[at + 2]);
+          run.shared.emplace_back(words[at], words[at + 1]);
         }
       }
-      for (Block& block : run.blocks)
+      std::sort(run.shared.begin(), run.shared.end());
+      run.shared.erase(std::unique(run.shared.begin(), run.shared.end()), run.shared.end());
+      run.isShared.assign(run.part.NumberOfVertices(), 0);
+      for (const auto& vb : run.shared)
       {
-        std::sort(block.SharedWith.begin(), block.SharedWith.end());
+        run.isShared[vb.first] = 1;
       }
     });
 }
 
 //------------------------------------------------------------------------------
-// Each block's triangles around its shared vertices, with their vertices, to the other blocks of
-// those vertices; then each block's mesh in local indices.
-bool vtkRGDecimate::SendHalos(Run& run)
+// The wave's blocks: each triangle of the part to the rank of its block, if that block is in
+// the wave, and to the blocks of the wave that share one of its vertices (their halo), with the
+// vertices' records; then each block's mesh in local indices.
+bool vtkRGDecimate::SendTriangles(Run& run, int wave)
 {
   const int size = run.ranks.Size;
   std::vector<std::vector<vtkIdType>> outgoing(static_cast<std::size_t>(size));
-  run.seen.SortUnique();
-  if (!run.ranks.Step("send the halos", run.problem,
+  if (!run.ranks.Step("send the triangles to their blocks", run.problem,
         [&]()
         {
-          // (rank, other block, block, triangle): each halo triangle once per block it goes to.
-          std::vector<std::array<vtkIdType, 4>> going;
-          for (std::size_t bi = 0; bi < run.blocks.size(); ++bi)
+          const SurfacePart& part = run.part;
+          std::vector<std::vector<Sending>> going(static_cast<std::size_t>(size));
+          std::vector<vtkIdType> others;
+          for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
           {
-            const Block& block = run.blocks[bi];
-            if (block.SharedWith.empty())
+            const vtkIdType block = run.partBlock[t];
+            if (run.waveOf[block] == wave)
+            {
+              going[run.owner[block]].push_back({ block, static_cast<vtkIdType>(t), 0 });
+            }
+            vtkIdType c[3];
+            part.Corners(t, c);
+            if (!run.isShared[c[0]] && !run.isShared[c[1]] && !run.isShared[c[2]])
             {
               continue;
             }
-            for (std::size_t t = 0; t < block.Own.size(); ++t)
+            others.clear();
+            for (vtkIdType v : c)
             {
-              for (vtkIdType id : block.Own[t])
+              auto range = std::equal_range(run.shared.begin(), run.shared.end(),
+                std::make_pair(v, vtkIdType(0)),
+                [](const std::pair<vtkIdType, vtkIdType>& a,
+                  const std::pair<vtkIdType, vtkIdType>& b) { return a.first < b.first; });
+              for (auto it = range.first; it != range.second; ++it)
               {
-                auto range = std::equal_range(block.SharedWith.begin(), block.SharedWith.end(),
-                  std::make_pair(id, vtkIdType(0)),
-                  [](const std::pair<vtkIdType, vtkIdType>& a,
-                    const std::pair<vtkIdType, vtkIdType>& b) { return a.first < b.first; });
-                for (auto it = range.first; it != range.second; ++it)
+                if (it->second != block && run.waveOf[it->second] == wave)
                 {
-                  going.push_back({ run.owner[it->second], it->second, static_cast<vtkIdType>(bi),
-                    static_cast<vtkIdType>(t) });
+                  others.push_back(it->second);
                 }
               }
             }
+            std::sort(others.begin(), others.end());
+            others.erase(std::unique(others.begin(), others.end()), others.end());
+            for (vtkIdType other : others)
+            {
+              going[run.owner[other]].push_back({ other, static_cast<vtkIdType>(t), 1 });
+            }
           }
-          std::sort(going.begin(), going.end());
-          going.erase(std::unique(going.begin(), going.end()), going.end());
           for (int r = 0; r < size; ++r)
           {
-            auto first = std::lower_bound(going.begin(), going.end(),
-              std::array<vtkIdType, 4>{ r, VTK_ID_MIN, VTK_ID_MIN, VTK_ID_MIN });
-            auto last = std::lower_bound(going.begin(), going.end(),
-              std::array<vtkIdType, 4>{ r + 1, VTK_ID_MIN, VTK_ID_MIN, VTK_ID_MIN });
-            WriteTriangles(outgoing[r], static_cast<std::size_t>(last - first), run.seen,
-              [&](std::size_t i, vtkIdType& block) -> const Triangle&
-              {
-                const auto& entry = *(first + static_cast<std::ptrdiff_t>(i));
-                block = entry[1];
-                return run.blocks[entry[2]].Own[entry[3]];
-              });
+            WriteTriangles(outgoing[r], going[r], part);
+            std::vector<Sending>().swap(going[r]);
           }
         }))
   {
     return false;
   }
-  auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), HaloTag);
-  const std::size_t seenBefore = run.seen.Vertices.size();
+  auto incoming = run.ranks.Exchange(std::move(outgoing), Everyone(size), TrianglesTag);
   return run.ranks.Step("assemble the blocks", run.problem,
     [&]()
     {
+      VertexTable seen; // the vertices of the wave's blocks' triangles
+      seen.HasQuadrics = run.part.HasQuadrics();
       for (auto& words : incoming)
       {
         ReadTriangles(
-          words, &Block::Halo, [&run](vtkIdType id) { return run.BlockWithId(id); }, run.seen);
-        std::vector<vtkIdType>().swap(words);
+          words, [&run](vtkIdType id) { return run.BlockWithId(id); }, seen);
+        std::vector<vtkIdType>().swap(words); // read: its memory goes back at once
       }
-      run.seen.SortUnique(seenBefore);
-      rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
-        [&](vtkIdType first, vtkIdType last)
+      seen.SortUnique();
+      const auto first = std::lower_bound(run.blocks.begin(), run.blocks.end(), wave,
+        [](const Block& b, int w) { return b.Wave < w; });
+      const auto last = std::upper_bound(
+        first, run.blocks.end(), wave, [](int w, const Block& b) { return w < b.Wave; });
+      rgmc::ParallelFor(static_cast<vtkIdType>(last - first), 1,
+        [&](vtkIdType from, vtkIdType to)
         {
-          for (vtkIdType b = first; b < last; ++b)
+          for (auto block = first + from; block != first + to; ++block)
           {
-            Block& block = run.blocks[b];
-            rgmc::DecimationBlock& mesh = block.Mesh;
-            for (const auto* list : { &block.Own, &block.Halo })
+            rgmc::DecimationBlock& mesh = block->Mesh;
+            for (const auto* list : { &block->Own, &block->Halo })
             {
               for (const Triangle& t : *list)
               {
@@ -840,15 +1105,14 @@ bool vtkRGDecimate::SendHalos(Run& run)
             const std::size_t n = mesh.Ids.size();
             mesh.Points.resize(3 * n);
             mesh.Quadrics.resize(n);
-            mesh.Fixed.assign(n, 0);
             for (std::size_t v = 0; v < n; ++v)
             {
-              const std::ptrdiff_t at = run.seen.Find(mesh.Ids[v]);
-              const Vertex& record = run.seen.Vertices[at];
+              const std::ptrdiff_t at = seen.Find(mesh.Ids[v]);
+              const Vertex& record = seen.Vertices[at];
               std::copy(record.Point, record.Point + 3, mesh.Points.begin() + 3 * v);
-              if (run.seen.HasQuadrics)
+              if (seen.HasQuadrics)
               {
-                mesh.Quadrics[v] = run.seen.Quadrics[at];
+                mesh.Quadrics[v] = seen.Quadrics[at];
               }
             }
             auto local = [&mesh](vtkIdType id)
@@ -856,22 +1120,34 @@ bool vtkRGDecimate::SendHalos(Run& run)
               return static_cast<int>(
                 std::lower_bound(mesh.Ids.begin(), mesh.Ids.end(), id) - mesh.Ids.begin());
             };
-            for (const auto& shared : block.SharedWith)
-            {
-              mesh.Fixed[local(shared.first)] = 1;
-            }
-            for (const Triangle& t : block.Own)
+            // A vertex of the block's own triangles that a halo triangle has too is shared with
+            // another block: fixed.
+            std::vector<std::uint8_t> inOwn(n, 0), inHalo(n, 0);
+            for (const Triangle& t : block->Own)
             {
               mesh.Triangles.push_back({ local(t[0]), local(t[1]), local(t[2]) });
+              for (int v : mesh.Triangles.back())
+              {
+                inOwn[v] = 1;
+              }
             }
-            for (const Triangle& t : block.Halo)
+            for (const Triangle& t : block->Halo)
             {
               mesh.Halo.push_back({ local(t[0]), local(t[1]), local(t[2]) });
+              for (int v : mesh.Halo.back())
+              {
+                inHalo[v] = 1;
+              }
             }
-            std::vector<Triangle>().swap(block.Own);
-            std::vector<Triangle>().swap(block.Halo);
+            mesh.Fixed.resize(n);
+            for (std::size_t v = 0; v < n; ++v)
+            {
+              mesh.Fixed[v] = inOwn[v] & inHalo[v];
+            }
+            std::vector<Triangle>().swap(block->Own);
+            std::vector<Triangle>().swap(block->Halo);
             mesh.SortTriangles();
-            if (!run.quadrics)
+            if (!seen.HasQuadrics)
             {
               // Area-weighted unless an error bound is asked for: see MaximumError.
               mesh.AreaWeighted = !(this->MaximumError > 0.0);
@@ -879,12 +1155,13 @@ bool vtkRGDecimate::SendHalos(Run& run)
             }
           }
         });
-      run.seen.Clear();
     });
 }
 
 //------------------------------------------------------------------------------
-bool vtkRGDecimate::SimplifyBlocks(Run& run)
+// The wave's blocks simplified (threads over blocks). With several waves, only the collapses'
+// levels are kept: ApplyCollapses makes the blocks again.
+bool vtkRGDecimate::SimplifyBlocks(Run& run, int wave)
 {
   const double maximumError = this->MaximumError;
   // No block needs more collapses than the whole surface still needs; and a block is stopped at
@@ -901,10 +1178,34 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run)
           for (vtkIdType b = first; b < last; ++b)
           {
             Block& block = run.blocks[b];
+            if (block.Wave != wave)
+            {
+              continue;
+            }
             const double share = 4.0 * needed * static_cast<double>(run.blockTriangles[block.Id]) /
               static_cast<double>(run.triangles);
             block.Log = rgmc::Simplify(block.Mesh, maximumError,
               static_cast<std::size_t>(std::ceil(std::min(needed, share))));
+            block.Levels.resize(block.Log.size());
+            for (std::size_t c = 0; c < block.Log.size(); ++c)
+            {
+              block.Levels[c] = block.Log[c].Level;
+            }
+            std::vector<char> used(block.Mesh.Ids.size(), 0);
+            for (const auto& t : block.Mesh.Triangles)
+            {
+              used[t[0]] = used[t[1]] = used[t[2]] = 1;
+            }
+            for (std::size_t v = 0; v < used.size(); ++v)
+            {
+              block.Vertices += used[v];
+              block.Fixed += used[v] && block.Mesh.Fixed[v];
+            }
+            if (run.waves > 1)
+            {
+              block.Mesh = rgmc::DecimationBlock();
+              std::vector<rgmc::Collapse>().swap(block.Log);
+            }
           }
         });
     });
@@ -912,8 +1213,7 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run)
 
 //------------------------------------------------------------------------------
 // How many collapses each block keeps: the cheapest over all blocks, by their level (the largest
-// error so far in their block), ties by block and order; then the kept collapses are applied and
-// the blocks' triangles become this rank's surface.
+// error so far in their block), ties by block and order.
 bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
 {
   Ranks& ranks = run.ranks;
@@ -921,17 +1221,9 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
   vtkIdType local[3] = { 0, 0, 0 }, sums[3] = { 0, 0, 0 };
   for (const Block& block : run.blocks)
   {
-    local[0] += static_cast<vtkIdType>(block.Log.size());
-    std::vector<char> used(block.Mesh.Ids.size(), 0);
-    for (const auto& t : block.Mesh.Triangles)
-    {
-      used[t[0]] = used[t[1]] = used[t[2]] = 1;
-    }
-    for (std::size_t v = 0; v < used.size(); ++v)
-    {
-      local[1] += used[v];
-      local[2] += used[v] && block.Mesh.Fixed[v];
-    }
+    local[0] += static_cast<vtkIdType>(block.Levels.size());
+    local[1] += static_cast<vtkIdType>(block.Vertices);
+    local[2] += static_cast<vtkIdType>(block.Fixed);
   }
   ranks.AllReduce(local, sums, 3, vtkCommunicator::SUM_OP, "counting the collapses");
   const vtkIdType found = sums[0];
@@ -951,11 +1243,9 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
     vtkIdType count = 0;
     for (const Block& block : run.blocks)
     {
-      auto end = strictly ? std::lower_bound(block.Log.begin(), block.Log.end(), level,
-                              [](const rgmc::Collapse& c, double x) { return c.Level < x; })
-                          : std::upper_bound(block.Log.begin(), block.Log.end(), level,
-                              [](double x, const rgmc::Collapse& c) { return x < c.Level; });
-      count += static_cast<vtkIdType>(end - block.Log.begin());
+      auto end = strictly ? std::lower_bound(block.Levels.begin(), block.Levels.end(), level)
+                          : std::upper_bound(block.Levels.begin(), block.Levels.end(), level);
+      count += static_cast<vtkIdType>(end - block.Levels.begin());
     }
     return count;
   };
@@ -963,125 +1253,173 @@ bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
   {
     for (Block& block : run.blocks)
     {
-      block.Keep = block.Log.size();
+      block.Keep = block.Levels.size();
+    }
+    return true;
+  }
+  // The smallest level with at least `needed` collapses at or below it: bisection on the bits
+  // of non-negative doubles, which order as their values do.
+  std::int64_t low = 0, high = 0x7FF0000000000000; // 0 and +infinity
+  while (low < high)
+  {
+    const std::int64_t middle = low + (high - low) / 2;
+    double level;
+    std::memcpy(&level, &middle, sizeof level);
+    const vtkIdType mine = atMost(level, false);
+    vtkIdType sum = 0;
+    ranks.AllReduce(&mine, &sum, 1, vtkCommunicator::SUM_OP, "selecting the threshold");
+    if (sum >= needed)
+    {
+      high = middle;
+    }
+    else
+    {
+      low = middle + 1;
+    }
+  }
+  double threshold;
+  std::memcpy(&threshold, &high, sizeof threshold);
+  // All collapses below the threshold; at it, the first ones in block order over the ranks.
+  const vtkIdType counts[2] = { atMost(threshold, true),
+    atMost(threshold, false) - atMost(threshold, true) };
+  std::vector<vtkIdType> gathered(2 * static_cast<std::size_t>(ranks.Size));
+  ranks.AllGather(counts, gathered.data(), 2, "sharing the counts at the threshold");
+  vtkIdType below = 0, earlierAt = 0;
+  for (int r = 0; r < ranks.Size; ++r)
+  {
+    below += gathered[2 * r];
+    earlierAt += r < ranks.Rank ? gathered[2 * r + 1] : 0;
+  }
+  vtkIdType atThreshold =
+    std::max<vtkIdType>(0, std::min<vtkIdType>(counts[1], needed - below - earlierAt));
+  for (Block& block : run.blocks)
+  {
+    auto lower = std::lower_bound(block.Levels.begin(), block.Levels.end(), threshold);
+    auto upper = std::upper_bound(block.Levels.begin(), block.Levels.end(), threshold);
+    const vtkIdType take = std::min<vtkIdType>(atThreshold, upper - lower);
+    block.Keep = static_cast<std::size_t>((lower - block.Levels.begin()) + take);
+    atThreshold -= take;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// The kept collapses applied, and the blocks' triangles, in block order, become this rank's
+// part. With several waves each wave's blocks are made again (the same content, so the same
+// collapses) and simplified as far as they keep.
+bool vtkRGDecimate::ApplyCollapses(Run& run)
+{
+  Ranks& ranks = run.ranks;
+  std::vector<Triangle> surface; // by global ids
+  VertexTable vertices;
+  vertices.HasQuadrics = true;
+  vtkIdType kept = 0;
+  double level = 0;
+  // Sized once from the counts (each collapse removes two of a block's own triangles), so that
+  // the largest of these lists is not made twice by growing.
+  std::size_t expected = 0;
+  for (const Block& block : run.blocks)
+  {
+    const std::size_t own = static_cast<std::size_t>(run.blockTriangles[block.Id]);
+    expected += own - std::min(own, 2 * block.Keep);
+  }
+  // The blocks' collapses are replayed in parallel (each block alone), then each block is
+  // copied and freed, block after block.
+  auto apply = [&](
+                 std::vector<Block>::iterator first, std::vector<Block>::iterator last, bool again)
+  {
+    if (surface.capacity() == 0)
+    {
+      surface.reserve(expected);
+      vertices.Reserve(expected / 2 + expected / 16);
+    }
+    std::vector<std::vector<char>> used(static_cast<std::size_t>(last - first));
+    rgmc::ParallelFor(static_cast<vtkIdType>(last - first), 1,
+      [&](vtkIdType from, vtkIdType to)
+      {
+        for (vtkIdType b = from; b < to; ++b)
+        {
+          Block& block = *(first + b);
+          if (again)
+          {
+            block.Log = rgmc::Simplify(block.Mesh, this->MaximumError, block.Keep);
+          }
+          rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
+          used[b].assign(block.Mesh.Ids.size(), 0);
+          for (const auto& t : block.Mesh.Triangles)
+          {
+            used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
+          }
+        }
+      });
+    for (auto block = first; block != last; ++block)
+    {
+      const std::size_t b = static_cast<std::size_t>(block - first);
+      kept += static_cast<vtkIdType>(block->Keep);
+      if (block->Keep > 0)
+      {
+        level = std::max(level, block->Levels[block->Keep - 1]);
+      }
+      const rgmc::DecimationBlock& mesh = block->Mesh;
+      for (const auto& t : mesh.Triangles)
+      {
+        surface.push_back({ mesh.Ids[t[0]], mesh.Ids[t[1]], mesh.Ids[t[2]] });
+      }
+      for (std::size_t v = 0; v < used[b].size(); ++v)
+      {
+        if (used[b][v])
+        {
+          Vertex record;
+          record.Id = mesh.Ids[v];
+          std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, record.Point);
+          vertices.Add(record, &mesh.Quadrics[v]);
+        }
+      }
+      *block = Block{ block->Id, block->Wave, {}, {}, {}, {}, {}, 0, 0, 0 };
+      std::vector<char>().swap(used[b]);
+    }
+  };
+  if (run.waves == 1)
+  {
+    if (!ranks.Step("apply the collapses", run.problem,
+          [&]() { apply(run.blocks.begin(), run.blocks.end(), false); }))
+    {
+      return false;
     }
   }
   else
   {
-    // The smallest level with at least `needed` collapses at or below it: bisection on the bits
-    // of non-negative doubles, which order as their values do.
-    std::int64_t low = 0, high = 0x7FF0000000000000; // 0 and +infinity
-    while (low < high)
+    for (int wave = 0; wave < run.waves; ++wave)
     {
-      const std::int64_t middle = low + (high - low) / 2;
-      double level;
-      std::memcpy(&level, &middle, sizeof level);
-      const vtkIdType mine = atMost(level, false);
-      vtkIdType all = 0;
-      ranks.AllReduce(&mine, &all, 1, vtkCommunicator::SUM_OP, "selecting the threshold");
-      if (all >= needed)
+      if (!this->SendTriangles(run, wave) ||
+        !ranks.Step("apply the collapses", run.problem,
+          [&]()
+          {
+            const auto first = std::lower_bound(run.blocks.begin(), run.blocks.end(), wave,
+              [](const Block& b, int w) { return b.Wave < w; });
+            const auto last = std::upper_bound(
+              first, run.blocks.end(), wave, [](int w, const Block& b) { return w < b.Wave; });
+            apply(first, last, true);
+          }))
       {
-        high = middle;
+        return false;
       }
-      else
-      {
-        low = middle + 1;
-      }
-    }
-    double threshold;
-    std::memcpy(&threshold, &high, sizeof threshold);
-    // All collapses below the threshold; at it, the first ones in block order over the ranks.
-    const vtkIdType counts[2] = { atMost(threshold, true),
-      atMost(threshold, false) - atMost(threshold, true) };
-    std::vector<vtkIdType> all(2 * static_cast<std::size_t>(ranks.Size));
-    ranks.AllGather(counts, all.data(), 2, "sharing the counts at the threshold");
-    vtkIdType below = 0, earlierAt = 0;
-    for (int r = 0; r < ranks.Size; ++r)
-    {
-      below += all[2 * r];
-      earlierAt += r < ranks.Rank ? all[2 * r + 1] : 0;
-    }
-    vtkIdType atThreshold =
-      std::max<vtkIdType>(0, std::min<vtkIdType>(counts[1], needed - below - earlierAt));
-    for (Block& block : run.blocks)
-    {
-      auto lower = std::lower_bound(block.Log.begin(), block.Log.end(), threshold,
-        [](const rgmc::Collapse& c, double x) { return c.Level < x; });
-      auto upper = std::upper_bound(block.Log.begin(), block.Log.end(), threshold,
-        [](double x, const rgmc::Collapse& c) { return x < c.Level; });
-      const vtkIdType take = std::min<vtkIdType>(atThreshold, upper - lower);
-      block.Keep = static_cast<std::size_t>((lower - block.Log.begin()) + take);
-      atThreshold -= take;
+      ReleaseFreeMemory();
     }
   }
-  vtkIdType kept = 0;
-  double level = 0;
-  if (!ranks.Step("apply the collapses", run.problem,
+  if (!ranks.Step("make the blocks the part", run.problem,
         [&]()
         {
-          run.vertices.Clear();
-          run.vertices.HasQuadrics = true;
-          // The blocks' collapses are replayed in parallel (each block alone); then the new
-          // surface and vertex records are sized once, and filled block after block, each
-          // block freed as soon as it is copied, so that the largest of these lists is not
-          // made twice by growing.
-          std::vector<std::vector<char>> used(run.blocks.size());
-          rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
-            [&](vtkIdType first, vtkIdType last)
-            {
-              for (vtkIdType b = first; b < last; ++b)
-              {
-                Block& block = run.blocks[b];
-                rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
-                used[b].assign(block.Mesh.Ids.size(), 0);
-                for (const auto& t : block.Mesh.Triangles)
-                {
-                  used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
-                }
-              }
-            });
-          std::size_t triangles = 0, records = 0;
-          for (std::size_t b = 0; b < run.blocks.size(); ++b)
-          {
-            triangles += run.blocks[b].Mesh.Triangles.size();
-            records += static_cast<std::size_t>(std::count(used[b].begin(), used[b].end(), 1));
-          }
-          run.surface.reserve(triangles);
-          run.vertices.Reserve(records);
-          for (std::size_t b = 0; b < run.blocks.size(); ++b)
-          {
-            Block& block = run.blocks[b];
-            kept += static_cast<vtkIdType>(block.Keep);
-            if (block.Keep > 0)
-            {
-              level = std::max(level, block.Log[block.Keep - 1].Level);
-            }
-            const rgmc::DecimationBlock& mesh = block.Mesh;
-            for (const auto& t : mesh.Triangles)
-            {
-              run.surface.push_back({ mesh.Ids[t[0]], mesh.Ids[t[1]], mesh.Ids[t[2]] });
-            }
-            for (std::size_t v = 0; v < used[b].size(); ++v)
-            {
-              if (used[b][v])
-              {
-                Vertex record;
-                record.Id = mesh.Ids[v];
-                std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, record.Point);
-                run.vertices.Add(record, &mesh.Quadrics[v]);
-              }
-            }
-            block = Block{ block.Id, {}, {}, {}, {}, {}, 0 };
-            std::vector<char>().swap(used[b]);
-          }
-          run.vertices.SortUnique();
           run.blocks.clear();
-          run.quadrics = true;
+          std::vector<std::int32_t>().swap(run.partBlock);
+          std::vector<std::pair<vtkIdType, vtkIdType>>().swap(run.shared);
+          std::vector<std::uint8_t>().swap(run.isShared);
+          run.part.Adopt(surface, vertices);
         }))
   {
     return false;
   }
-  const vtkIdType mine[2] = { static_cast<vtkIdType>(run.surface.size()), kept };
+  const vtkIdType mine[2] = { static_cast<vtkIdType>(run.part.NumberOfTriangles()), kept };
   vtkIdType after[2] = { 0, 0 };
   ranks.AllReduce(mine, after, 2, vtkCommunicator::SUM_OP, "counting the triangles");
   double largest = 0;
@@ -1107,28 +1445,26 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
           {
             points->SetDataType(run.input->GetPoints()->GetDataType());
           }
-          const vtkIdType n = static_cast<vtkIdType>(run.vertices.Vertices.size());
+          SurfacePart& part = run.part;
+          part.OwnInput(); // when no pass ran
+          const vtkIdType n = static_cast<vtkIdType>(part.Vertices.Vertices.size());
           points->SetNumberOfPoints(n);
           vtkNew<vtkIdTypeArray> ids;
           ids->SetName("DecimatedVertexIds");
           rgmc::Allocate(ids.Get(), n);
           for (vtkIdType v = 0; v < n; ++v)
           {
-            points->SetPoint(v, run.vertices.Vertices[v].Point);
-            ids->SetValue(v, run.vertices.Vertices[v].Id);
+            points->SetPoint(v, part.Vertices.Vertices[v].Point);
+            ids->SetValue(v, part.Vertices.Vertices[v].Id);
           }
           vtkNew<vtkIdTypeArray> connectivity, offsets;
-          const vtkIdType t = static_cast<vtkIdType>(run.surface.size());
+          const vtkIdType t = static_cast<vtkIdType>(part.Triangles.size());
           vtkIdType* c = rgmc::Allocate(connectivity.Get(), 3 * t);
           vtkIdType* o = rgmc::Allocate(offsets.Get(), t + 1);
           for (vtkIdType i = 0; i < t; ++i)
           {
             o[i] = 3 * i;
-            for (int k = 0; k < 3; ++k)
-            {
-              const vtkIdType id = run.surface[i][k];
-              c[3 * i + k] = run.vertices.Find(id);
-            }
+            std::copy(part.Triangles[i].begin(), part.Triangles[i].end(), c + 3 * i);
           }
           o[t] = 3 * t;
           vtkNew<vtkCellArray> polys;
@@ -1137,8 +1473,7 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
           piece->SetPolys(polys);
           piece->GetPointData()->SetGlobalIds(ids);
           piece->GetFieldData()->PassData(run.input->GetFieldData());
-          std::vector<Triangle>().swap(run.surface);
-          run.vertices.Clear();
+          part.Clear();
         }))
   {
     return false;
@@ -1194,6 +1529,7 @@ void vtkRGDecimate::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TargetReduction: " << this->TargetReduction << "\n";
   os << indent << "MaximumError: " << this->MaximumError << "\n";
   os << indent << "TrianglesPerBlock: " << this->TrianglesPerBlock << "\n";
+  os << indent << "TrianglesPerWave: " << this->TrianglesPerWave << "\n";
   os << indent << "Controller: " << this->Controller << "\n";
   os << indent << "NumberOfCollectives: " << this->NumberOfCollectives << "\n";
 }

@@ -43,12 +43,18 @@
  * Steps of a pass:
  * 1. Count the triangles of each block (AllReduce); blocks go to ranks in contiguous ranges of
  *    balanced counts.
- * 2. Send each triangle, with its vertices' positions and quadrics, to its block's rank.
- * 3. Find the vertices shared by several blocks: (vertex, block) pairs go to the rank of the
- *    vertex (its global id modulo the ranks), which answers each block with the other blocks.
- * 4. Send each block the other blocks' triangles around its shared vertices (its halo).
- * 5. Simplify the blocks (threads over blocks); select the threshold (AllReduce, bisection on the
+ * 2. Find the vertices shared by several blocks: (vertex, block) pairs go to the rank of the
+ *    vertex (its global id modulo the ranks), which answers the ranks that hold the vertex with
+ *    all its blocks.
+ * 3. Send each triangle, with its vertices' positions and quadrics, to its block's rank, and to
+ *    the other blocks of its vertices as their halo (the triangles around the vertices a block
+ *    shares, which it needs to keep them fixed and to sum their quadrics).
+ * 4. Simplify the blocks (threads over blocks); select the threshold (AllReduce, bisection on the
  *    error's bits); keep each block's collapses up to it.
+ * A rank whose blocks hold more than TrianglesPerWave triangles does steps 3 and 4 in waves of
+ * its blocks, keeping only the collapses' errors of each wave, and makes and simplifies each
+ * wave again, as far as it keeps, once the threshold is known: it then holds one wave's blocks
+ * at a time, not all of them. The first pass reads the input in place, without a copy.
  * After the last pass the pieces are numbered as one mesh by an internal vtkRGSeamRepair (no
  * smoothing), which also recomputes normals and the checks and measures in field data.
  * Nothing is gathered on one rank; a rank's memory follows its share of the blocks. Errors are
@@ -109,6 +115,18 @@ public:
 
   ///@{
   /**
+   * Memory: a rank whose blocks hold more than this many triangles in a pass (default
+   * 4000000; at least 100) makes and simplifies them in waves of contiguous blocks, at least 16
+   * and of about this many triangles each, holding one wave's blocks at a time instead of all;
+   * the blocks are then made and simplified a second time, as far as the collapses kept, once
+   * the threshold is known, so a pass takes longer. The result never depends on it.
+   */
+  vtkSetClampMacro(TrianglesPerWave, vtkIdType, 100, VTK_ID_MAX);
+  vtkGetMacro(TrianglesPerWave, vtkIdType);
+  ///@}
+
+  ///@{
+  /**
    * The controller that links the ranks (default: the global controller).
    */
   void SetController(vtkMultiProcessController*);
@@ -129,6 +147,7 @@ protected:
   double TargetReduction = 0.9;
   double MaximumError = 0.0;
   vtkIdType TrianglesPerBlock = 20000;
+  vtkIdType TrianglesPerWave = 4000000;
   vtkMultiProcessController* Controller = nullptr;
   vtkIdType NumberOfCollectives = 0;
 
@@ -142,11 +161,11 @@ private:
   bool CheckInput(Run& run);
   bool ReadSurface(Run& run);
   bool PlaceBlocks(Run& run, int pass);
-  bool SendTriangles(Run& run);
   bool FindSharedVertices(Run& run);
-  bool SendHalos(Run& run);
-  bool SimplifyBlocks(Run& run);
+  bool SendTriangles(Run& run, int wave);
+  bool SimplifyBlocks(Run& run, int wave);
   bool KeepCheapest(Run& run, bool all);
+  bool ApplyCollapses(Run& run);
   bool NumberSurface(Run& run, vtkPolyData* output);
 };
 

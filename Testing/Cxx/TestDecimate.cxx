@@ -6,7 +6,8 @@
 // closed with the input's Euler characteristic (checked by the project's edge counts and by
 // counting the gathered mesh's edges here); the border's vertices where they were; the triangle
 // count within 1% of the target; every vertex within the asked error of the original surface
-// when an error bound is set. Bad input gives the same error on every rank.
+// when an error bound is set; made in waves (TrianglesPerWave), the same surface to the bit.
+// Bad input gives the same error on every rank.
 #include "rgmcDistributedData.h"
 #include "rgmcTestController.h"
 #include "rgmcTestData.h"
@@ -121,7 +122,8 @@ struct Decimated
 const vtkIdType TrianglesPerBlock = 500;
 
 Decimated Decimate(vtkMultiProcessController* controller, vtkPolyData* input, double reduction,
-  double maximumError = 0.0, vtkIdType trianglesPerBlock = TrianglesPerBlock)
+  double maximumError = 0.0, vtkIdType trianglesPerBlock = TrianglesPerBlock,
+  vtkIdType trianglesPerWave = 4000000)
 {
   vtkNew<vtkRGDecimate> decimate;
   vtkNew<MessageCatcher> catcher;
@@ -131,6 +133,7 @@ Decimated Decimate(vtkMultiProcessController* controller, vtkPolyData* input, do
   decimate->SetTargetReduction(reduction);
   decimate->SetMaximumError(maximumError);
   decimate->SetTrianglesPerBlock(trianglesPerBlock);
+  decimate->SetTrianglesPerWave(trianglesPerWave);
   UpdateAtThreads(decimate, "Decimate",
     [&catcher]()
     {
@@ -494,6 +497,15 @@ int main(int argc, char* argv[])
         RGMC_CHECK(away == 0,
           surface.Name << ": " << away << " triangles face away from the original surface");
       }
+      // In waves (the blocks made and simplified a few at a time, then made again to apply
+      // what they keep): the same surface to the bit.
+      {
+        const Decimated waves = Decimate(single, repaired, reduction, 0.0, TrianglesPerBlock, 1000);
+        const Merged wavesMesh = Gather(single, waves.Output);
+        RGMC_CHECK(
+          wavesMesh.Points == reference.Points && wavesMesh.Triangles == reference.Triangles,
+          surface.Name << " in waves of 1000 triangles: not the surface made at once");
+      }
       // Tiny blocks (most vertices near a block's face in every pass): more passes, the same
       // guarantees, and still the target.
       {
@@ -555,6 +567,19 @@ int main(int argc, char* argv[])
         RGMC_CHECK(output.Triangles == reference.Triangles,
           what << ": the triangles differ from 1 rank's (" << output.Triangles.size() << " and "
                << reference.Triangles.size() << ", or in another order)");
+      }
+      // In waves, on the first decomposition: each rank's blocks a few at a time.
+      if (how == Decompositions(ranks).front())
+      {
+        const Decimated waves =
+          Decimate(controller, repaired, reduction, 0.0, TrianglesPerBlock, 1000);
+        const Merged wavesMesh = Gather(controller, waves.Output);
+        if (rank == 0)
+        {
+          RGMC_CHECK(
+            wavesMesh.Points == reference.Points && wavesMesh.Triangles == reference.Triangles,
+            what << ", in waves of 1000 triangles: not 1 rank's surface");
+        }
       }
     }
   }
