@@ -571,10 +571,10 @@ struct vtkRGDecimate::Run
   std::vector<int> waveOf;               // per block: the wave of its rank's blocks it is in
   int waves = 1;                         // on every rank, the same number
   std::vector<std::int32_t> partBlock;   // the block of each of the part's triangles
-  // The part's vertices in several blocks: (vertex, block) for each of their blocks, sorted,
-  // and a flag per vertex.
-  std::vector<std::pair<vtkIdType, vtkIdType>> shared;
-  std::vector<std::uint8_t> isShared;
+  // The blocks of the part's vertices that are in several blocks: those of vertex v are
+  // sharedBlocks[sharedFirst[v]] to sharedBlocks[sharedFirst[v + 1] - 1] (none for the others).
+  std::vector<std::uint32_t> sharedFirst;
+  std::vector<std::int32_t> sharedBlocks;
   std::vector<Block> blocks; // this rank's, by increasing id, so by wave
   vtkIdType collapses = 0;   // made in the last pass, over all ranks
   int passes = 0;
@@ -995,20 +995,26 @@ bool vtkRGDecimate::FindSharedVertices(Run& run)
   return run.ranks.Step("record the shared vertices", run.problem,
     [&]()
     {
-      run.shared.clear();
+      std::vector<std::pair<vtkIdType, vtkIdType>> shared; // (vertex, block)
       for (const auto& words : told)
       {
         for (std::size_t at = 0; at + 1 < words.size(); at += 2)
         {
-          run.shared.emplace_back(words[at], words[at + 1]);
+          shared.emplace_back(words[at], words[at + 1]);
         }
       }
-      std::sort(run.shared.begin(), run.shared.end());
-      run.shared.erase(std::unique(run.shared.begin(), run.shared.end()), run.shared.end());
-      run.isShared.assign(run.part.NumberOfVertices(), 0);
-      for (const auto& vb : run.shared)
+      std::sort(shared.begin(), shared.end());
+      shared.erase(std::unique(shared.begin(), shared.end()), shared.end());
+      run.sharedFirst.assign(run.part.NumberOfVertices() + 1, 0);
+      run.sharedBlocks.resize(shared.size());
+      for (std::size_t i = 0; i < shared.size(); ++i)
       {
-        run.isShared[vb.first] = 1;
+        ++run.sharedFirst[shared[i].first + 1];
+        run.sharedBlocks[i] = static_cast<std::int32_t>(shared[i].second);
+      }
+      for (std::size_t v = 1; v < run.sharedFirst.size(); ++v)
+      {
+        run.sharedFirst[v] += run.sharedFirst[v - 1];
       }
     });
 }
@@ -1036,24 +1042,21 @@ bool vtkRGDecimate::SendTriangles(Run& run, int wave)
             }
             vtkIdType c[3];
             part.Corners(t, c);
-            if (!run.isShared[c[0]] && !run.isShared[c[1]] && !run.isShared[c[2]])
-            {
-              continue;
-            }
             others.clear();
             for (vtkIdType v : c)
             {
-              auto range = std::equal_range(run.shared.begin(), run.shared.end(),
-                std::make_pair(v, vtkIdType(0)),
-                [](const std::pair<vtkIdType, vtkIdType>& a,
-                  const std::pair<vtkIdType, vtkIdType>& b) { return a.first < b.first; });
-              for (auto it = range.first; it != range.second; ++it)
+              for (std::uint32_t i = run.sharedFirst[v]; i < run.sharedFirst[v + 1]; ++i)
               {
-                if (it->second != block && run.waveOf[it->second] == wave)
+                const vtkIdType other = run.sharedBlocks[i];
+                if (other != block && run.waveOf[other] == wave)
                 {
-                  others.push_back(it->second);
+                  others.push_back(other);
                 }
               }
+            }
+            if (others.empty())
+            {
+              continue;
             }
             std::sort(others.begin(), others.end());
             others.erase(std::unique(others.begin(), others.end()), others.end());
@@ -1412,8 +1415,8 @@ bool vtkRGDecimate::ApplyCollapses(Run& run)
         {
           run.blocks.clear();
           std::vector<std::int32_t>().swap(run.partBlock);
-          std::vector<std::pair<vtkIdType, vtkIdType>>().swap(run.shared);
-          std::vector<std::uint8_t>().swap(run.isShared);
+          std::vector<std::uint32_t>().swap(run.sharedFirst);
+          std::vector<std::int32_t>().swap(run.sharedBlocks);
           run.part.Adopt(surface, vertices);
         }))
   {
