@@ -580,6 +580,15 @@ struct vtkRGDecimate::Run
   int passes = 0;
   double maximumLevel = 0; // the largest quadric error kept, over all ranks
 
+  /// This rank's blocks of `wave` (contiguous: blocks are in wave order).
+  std::pair<std::vector<Block>::iterator, std::vector<Block>::iterator> BlocksOfWave(int wave)
+  {
+    return std::equal_range(this->blocks.begin(), this->blocks.end(), wave,
+      [](const auto& a, const auto& b) { return WaveOf(a) < WaveOf(b); });
+  }
+  static int WaveOf(const Block& b) { return b.Wave; }
+  static int WaveOf(int wave) { return wave; }
+
   Block* BlockWithId(vtkIdType id)
   {
     auto at = std::lower_bound(this->blocks.begin(), this->blocks.end(), id,
@@ -1087,10 +1096,8 @@ bool vtkRGDecimate::SendTriangles(Run& run, int wave)
         std::vector<vtkIdType>().swap(words); // read: its memory goes back at once
       }
       seen.SortUnique();
-      const auto first = std::lower_bound(run.blocks.begin(), run.blocks.end(), wave,
-        [](const Block& b, int w) { return b.Wave < w; });
-      const auto last = std::upper_bound(
-        first, run.blocks.end(), wave, [](int w, const Block& b) { return w < b.Wave; });
+      const auto blocks = run.BlocksOfWave(wave);
+      const auto first = blocks.first, last = blocks.second;
       rgmc::ParallelFor(static_cast<vtkIdType>(last - first), 1,
         [&](vtkIdType from, vtkIdType to)
         {
@@ -1398,10 +1405,8 @@ bool vtkRGDecimate::ApplyCollapses(Run& run)
         !ranks.Step("apply the collapses", run.problem,
           [&]()
           {
-            const auto first = std::lower_bound(run.blocks.begin(), run.blocks.end(), wave,
-              [](const Block& b, int w) { return b.Wave < w; });
-            const auto last = std::upper_bound(
-              first, run.blocks.end(), wave, [](int w, const Block& b) { return w < b.Wave; });
+            const auto blocks = run.BlocksOfWave(wave);
+            const auto first = blocks.first, last = blocks.second;
             apply(first, last, true);
           }))
       {
