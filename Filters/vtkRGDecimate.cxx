@@ -404,6 +404,8 @@ public:
       this->Input->GetPoint(v, p);
     }
   }
+  /// How many message words Write gives a vertex.
+  std::size_t WordsPerVertex() const { return this->HasQuadrics() ? 14 : 4; }
   /// Message words of vertex `v`: id and position, then its quadric's 10 terms if it has one.
   void Write(vtkIdType v, std::vector<vtkIdType>& words) const
   {
@@ -478,11 +480,28 @@ void WriteTriangles(
   std::stable_partition(going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; });
   const auto halos =
     std::count_if(going.begin(), going.end(), [](const Sending& s) { return s[2]; });
-  words.reserve(2 + 4 * going.size() + 3 * going.size() * (part.HasQuadrics() ? 14 : 4) / 2);
-  words.push_back(static_cast<vtkIdType>(going.size()) - halos);
-  words.push_back(halos);
+  // The corners' vertices, by id (each written once), first: the message's size is then known.
   std::vector<std::pair<vtkIdType, vtkIdType>> vertices; // (id, index in the part)
   vertices.reserve(3 * going.size());
+  for (const Sending& s : going)
+  {
+    vtkIdType c[3];
+    part.Corners(static_cast<std::size_t>(s[1]), c);
+    for (vtkIdType v : c)
+    {
+      vertices.emplace_back(part.Id(v), v);
+    }
+  }
+  rgmc::RadixSort(
+    vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); });
+  std::size_t distinct = 0;
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+  {
+    distinct += i == 0 || vertices[i].first != vertices[i - 1].first;
+  }
+  words.reserve(words.size() + 2 + 4 * going.size() + part.WordsPerVertex() * distinct);
+  words.push_back(static_cast<vtkIdType>(going.size()) - halos);
+  words.push_back(halos);
   for (const Sending& s : going)
   {
     vtkIdType c[3];
@@ -490,13 +509,9 @@ void WriteTriangles(
     words.push_back(s[0]);
     for (vtkIdType v : c)
     {
-      const vtkIdType id = part.Id(v);
-      words.push_back(id);
-      vertices.emplace_back(id, v);
+      words.push_back(part.Id(v));
     }
   }
-  rgmc::RadixSort(
-    vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); });
   for (std::size_t i = 0; i < vertices.size(); ++i)
   {
     if (i == 0 || vertices[i].first != vertices[i - 1].first)
@@ -1182,16 +1197,13 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run, int wave)
   return run.ranks.Step("simplify the blocks", run.problem,
     [&]()
     {
-      rgmc::ParallelFor(static_cast<vtkIdType>(run.blocks.size()), 1,
+      const auto blocks = run.BlocksOfWave(wave);
+      rgmc::ParallelFor(static_cast<vtkIdType>(blocks.second - blocks.first), 1,
         [&](vtkIdType first, vtkIdType last)
         {
           for (vtkIdType b = first; b < last; ++b)
           {
-            Block& block = run.blocks[b];
-            if (block.Wave != wave)
-            {
-              continue;
-            }
+            Block& block = blocks.first[b];
             const double share = 4.0 * needed * static_cast<double>(run.blockTriangles[block.Id]) /
               static_cast<double>(run.triangles);
             block.Log = rgmc::Simplify(block.Mesh, maximumError,

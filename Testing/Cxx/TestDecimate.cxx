@@ -28,6 +28,8 @@
 #include "vtkRGPhantomSource.h"
 #include "vtkRGSeamRepair.h"
 
+#include <algorithm>
+#include <array>
 #include <cstring>
 #include <iostream>
 #include <map>
@@ -276,6 +278,26 @@ Merged Gather(vtkMultiProcessController* controller, vtkPolyData* piece)
   return merged;
 }
 
+/// The triangles as triples of their corners' positions (bits), each turned to start at its
+/// least corner (orientation kept), sorted: the mesh whatever its numbering and order.
+std::vector<std::array<std::array<std::uint64_t, 3>, 3>> TrianglesByPosition(const Merged& mesh)
+{
+  std::vector<std::array<std::array<std::uint64_t, 3>, 3>> out;
+  for (const auto& t : mesh.Triangles)
+  {
+    std::array<std::array<std::uint64_t, 3>, 3> corners;
+    for (int k = 0; k < 3; ++k)
+    {
+      const auto& bits = mesh.Points.at(t[k]);
+      corners[k] = { bits[0], bits[1], bits[2] };
+    }
+    std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end()), corners.end());
+    out.push_back(corners);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 /// The largest distance from a vertex of `decimated` to the surface `original`.
 double FarthestVertex(vtkPolyData* decimated, vtkPolyData* original)
 {
@@ -506,6 +528,16 @@ int main(int argc, char* argv[])
           wavesMesh.Points == reference.Points && wavesMesh.Triangles == reference.Triangles,
           surface.Name << " in waves of 1000 triangles: not the surface made at once");
       }
+      // Nothing to remove (a Target Reduction that rounds to no triangle: no pass runs): the
+      // input surface itself, its points and triangles, numbered as the output is.
+      {
+        const Decimated none = Decimate(single, repaired, 1e-9);
+        RGMC_CHECK(none.Errors.empty(), surface.Name << ", nothing to remove: " << none.Errors);
+        const Merged noneMesh = Gather(single, none.Output);
+        CheckSurface(input, noneMesh, none.Output, 0.0, surface.Name + ", nothing to remove");
+        RGMC_CHECK(TrianglesByPosition(noneMesh) == TrianglesByPosition(input),
+          surface.Name << ", nothing to remove: not the input's triangles");
+      }
       // Tiny blocks (most vertices near a block's face in every pass): more passes, the same
       // guarantees, and still the target.
       {
@@ -579,6 +611,15 @@ int main(int argc, char* argv[])
           RGMC_CHECK(
             wavesMesh.Points == reference.Points && wavesMesh.Triangles == reference.Triangles,
             what << ", in waves of 1000 triangles: not 1 rank's surface");
+        }
+        // Nothing to remove: each rank's piece as it came.
+        const Decimated none = Decimate(controller, repaired, 1e-9);
+        const Merged noneMesh = Gather(controller, none.Output);
+        if (rank == 0)
+        {
+          RGMC_CHECK(
+            none.Errors.empty() && TrianglesByPosition(noneMesh) == TrianglesByPosition(input),
+            what << ", nothing to remove: not the input's triangles " << none.Errors);
         }
       }
     }
