@@ -181,7 +181,7 @@ public:
     {
       start[s + 1] += start[s];
     }
-    std::vector<SurfaceNode> nodes(found.size());
+    LargeVector<SurfaceNode> nodes(found.size()); // huge pages: 16 B per node, written at once
     {
       std::vector<std::int64_t> next(start.begin(), start.end() - 1);
       found.ForEach([&](const SurfaceNode& n) { nodes[next[n.K - box.Lo[2]]++] = n; });
@@ -304,7 +304,7 @@ private:
     this->Pool.push_back(std::move(work));
   }
 
-  void ExtractChunk(const std::vector<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
+  void ExtractChunk(const LargeVector<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
     int first, int last, std::int64_t triangles, Chunk& chunk)
   {
     const CellBox& box = this->NodeBox;
