@@ -20,6 +20,9 @@
 namespace rgmc
 {
 
+/// A huge page (Linux's transparent huge pages on x86-64 and arm64).
+constexpr std::size_t HugePage = std::size_t(1) << 21;
+
 /// Asks the operating system to back the 2 MiB-aligned part of [data, data + bytes) with huge
 /// pages where it can (Linux's transparent huge pages, which Debian's kernels give on request):
 /// a large array is then paged in 2 MiB at a time, one page fault where there would be 512.
@@ -27,7 +30,7 @@ namespace rgmc
 inline void AdviseHugePages(void* data, std::size_t bytes)
 {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t huge = std::uintptr_t(1) << 21;
+  constexpr std::uintptr_t huge = HugePage;
   if (!data || bytes < 2 * huge)
   {
     return;
@@ -45,12 +48,38 @@ inline void AdviseHugePages(void* data, std::size_t bytes)
 #endif
 }
 
-/// std::allocator for large arrays (Seam Repair's per-vertex and per-triangle arrays): an array
-/// of 4 MiB or more is put in whole huge pages, 2 MiB-aligned and rounded up to 2 MiB, so that
-/// none of it is paged in 4 KiB at a time (AdviseHugePages alone leaves up to 2 MiB at each end
-/// in small pages). The cost: up to 2 MiB per array resident beyond what it uses (the rest of
-/// the huge page its last value is in). Measured on Seam Repair of the 512^3 skull: 0.63 ->
-/// 0.54-0.59 s on one thread; peak +7 MiB on a 6.7 M-triangle surface (docs/evaluation.md).
+/// Whether an array of `bytes` goes in whole huge pages (AllocateHugePages): 4 MiB or more.
+inline bool WantsHugePages(std::size_t bytes)
+{
+  return bytes >= 2 * HugePage;
+}
+
+/// Storage for an array of `bytes` that is written whole soon after (WantsHugePages), in whole
+/// huge pages: 2 MiB-aligned, rounded up to 2 MiB, huge pages asked for. AdviseHugePages alone
+/// leaves up to 2 MiB at each end of an array in 4 KiB pages; under a hypervisor a page fault
+/// costs microseconds, and a 2 M-triangle surface's arrays are 20 000 pages of 4 KiB. The cost:
+/// up to 2 MiB resident beyond the array (the rest of its last huge page), so not for a
+/// reserved upper bound. Sets `rounded` to the bytes given; released with std::free.
+inline void* AllocateHugePages(std::size_t bytes, std::size_t& rounded)
+{
+  if (bytes > static_cast<std::size_t>(PTRDIFF_MAX) - HugePage)
+  {
+    throw std::bad_alloc();
+  }
+  rounded = (bytes + HugePage - 1) & ~(HugePage - 1);
+  void* data = std::aligned_alloc(HugePage, rounded);
+  if (!data)
+  {
+    throw std::bad_alloc();
+  }
+  AdviseHugePages(data, rounded);
+  return data;
+}
+
+/// std::allocator for large arrays (Seam Repair's per-vertex and per-triangle arrays): those of
+/// 4 MiB or more in whole huge pages (AllocateHugePages). Measured on Seam Repair of the 512^3
+/// skull: 0.63 -> 0.54-0.59 s on one thread; peak +7 MiB on a 6.7 M-triangle surface
+/// (docs/evaluation.md).
 template <typename T>
 struct LargeArrayAllocator
 {
@@ -60,32 +89,23 @@ struct LargeArrayAllocator
   LargeArrayAllocator(const LargeArrayAllocator<U>&) noexcept
   {
   }
-  /// Arrays of 4 MiB or more take whole huge pages: 2 MiB-aligned, rounded up to 2 MiB.
-  static constexpr std::size_t Huge = std::size_t(1) << 21;
-  static bool Large(std::size_t n) { return n * sizeof(T) >= 2 * Huge; }
-  static std::size_t Rounded(std::size_t n) { return (n * sizeof(T) + Huge - 1) & ~(Huge - 1); }
   T* allocate(std::size_t n)
   {
-    if (!Large(n))
+    if (n > std::size_t(PTRDIFF_MAX) / sizeof(T) || !WantsHugePages(n * sizeof(T)))
     {
-      return std::allocator<T>().allocate(n);
+      return std::allocator<T>().allocate(n); // throws on a length too large
     }
-    if (n > (static_cast<std::size_t>(PTRDIFF_MAX) - Huge) / sizeof(T))
-    {
-      throw std::bad_array_new_length();
-    }
-    void* data = ::operator new(Rounded(n), std::align_val_t(Huge));
-    AdviseHugePages(data, Rounded(n));
-    return static_cast<T*>(data);
+    std::size_t rounded;
+    return static_cast<T*>(AllocateHugePages(n * sizeof(T), rounded));
   }
   void deallocate(T* data, std::size_t n) noexcept
   {
-    if (!Large(n))
+    if (!WantsHugePages(n * sizeof(T)))
     {
       std::allocator<T>().deallocate(data, n);
       return;
     }
-    ::operator delete(data, std::align_val_t(Huge));
+    std::free(data);
   }
   template <typename U>
   bool operator==(const LargeArrayAllocator<U>&) const noexcept
@@ -181,28 +201,19 @@ public:
     this->Size += n;
   }
 
-  /// Holds n values, those beyond the old size left unset (to be written next, all of them).
-  /// Storage made here for 4 MiB or more (the joined mesh's arrays: tens of MB, written once,
-  /// soon after they are made) is in whole huge pages, 2 MiB-aligned and rounded up to 2 MiB, so
-  /// that none of it is paged in 4 KiB at a time: a page fault costs microseconds under a
-  /// hypervisor, and a 2 M-triangle surface's arrays are 20 000 pages of 4 KiB. (Not in
-  /// reserve: a reserved upper bound's last huge page would be resident unused.)
+  /// Holds n values, those beyond the old size left unset (to be written next, all of them):
+  /// new storage of 4 MiB or more (the joined mesh's arrays) in whole huge pages
+  /// (AllocateHugePages; not in reserve, whose upper bounds would keep their last one unused).
   void resize_for_overwrite(std::size_t n)
   {
-    constexpr std::size_t huge = std::size_t(1) << 21;
-    if (n <= this->Capacity || n * sizeof(T) < 2 * huge)
+    if (n <= this->Capacity || !WantsHugePages(n * sizeof(T)))
     {
       this->reserve(n);
       this->Size = n;
       return;
     }
-    const std::size_t rounded = (n * sizeof(T) + huge - 1) & ~(huge - 1);
-    T* grown = static_cast<T*>(std::aligned_alloc(huge, rounded));
-    if (!grown)
-    {
-      throw std::bad_alloc();
-    }
-    AdviseHugePages(grown, rounded);
+    std::size_t rounded;
+    T* grown = static_cast<T*>(AllocateHugePages(n * sizeof(T), rounded));
     if (this->Size > 0)
     {
       std::memcpy(grown, this->Data, this->Size * sizeof(T));
