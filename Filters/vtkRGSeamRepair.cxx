@@ -759,7 +759,7 @@ public:
   std::vector<double> BorderEdges(const T* positions, const rgmc::VolumeBox& box) const
   {
     std::vector<int> faces(static_cast<std::size_t>(this->NumVertices));
-    rgmc::ParallelFor(this->NumVertices, 4096,
+    rgmc::ParallelFor(this->NumVertices, RowGrain,
       [&](vtkIdType first, vtkIdType last)
       {
         for (vtkIdType v = first; v < last; ++v)
@@ -767,30 +767,54 @@ public:
           faces[v] = this->MaskOf(v);
         }
       });
-    std::vector<double> packed;
-    for (vtkIdType t = 0; t < this->NumTriangles; ++t)
-    {
-      for (int c = 0; c < 3; ++c)
+    // Blocks of triangles on threads, each packing its own edges, joined in triangle order.
+    const vtkIdType grain = 65536;
+    std::vector<std::vector<double>> parts(
+      static_cast<std::size_t>((this->NumTriangles + grain - 1) / grain));
+    rgmc::ParallelFor(static_cast<vtkIdType>(parts.size()), 1,
+      [&](vtkIdType firstBlock, vtkIdType lastBlock)
       {
-        const vtkIdType a = static_cast<vtkIdType>(this->Triangles[3 * t + c]);
-        const vtkIdType b = static_cast<vtkIdType>(this->Triangles[3 * t + (c + 1) % 3]);
-        if (!(faces[a] & faces[b]))
+        for (vtkIdType block = firstBlock; block < lastBlock; ++block)
         {
-          continue;
+          std::vector<double> packed;
+          for (vtkIdType t = block * grain; t < std::min(this->NumTriangles, (block + 1) * grain);
+               ++t)
+          {
+            for (int c = 0; c < 3; ++c)
+            {
+              const vtkIdType a = static_cast<vtkIdType>(this->Triangles[3 * t + c]);
+              const vtkIdType b = static_cast<vtkIdType>(this->Triangles[3 * t + (c + 1) % 3]);
+              if (!(faces[a] & faces[b]))
+              {
+                continue;
+              }
+              rgmc::BorderEdge e;
+              e.From = this->Numbering.Gid[a];
+              e.To = this->Numbering.Gid[b];
+              e.FromFaces = faces[a];
+              e.ToFaces = faces[b];
+              double x[3];
+              std::copy_n(positions + 3 * a, 3, x);
+              box.ToIndex(x, e.FromIndex);
+              std::copy_n(positions + 3 * b, 3, x);
+              box.ToIndex(x, e.ToIndex);
+              packed.resize(packed.size() + rgmc::BorderEdge::Words);
+              e.Pack(packed.data() + packed.size() - rgmc::BorderEdge::Words);
+            }
+          }
+          parts[block] = std::move(packed);
         }
-        rgmc::BorderEdge e;
-        e.From = this->Numbering.Gid[a];
-        e.To = this->Numbering.Gid[b];
-        e.FromFaces = faces[a];
-        e.ToFaces = faces[b];
-        double x[3];
-        std::copy_n(positions + 3 * a, 3, x);
-        box.ToIndex(x, e.FromIndex);
-        std::copy_n(positions + 3 * b, 3, x);
-        box.ToIndex(x, e.ToIndex);
-        packed.resize(packed.size() + rgmc::BorderEdge::Words);
-        e.Pack(packed.data() + packed.size() - rgmc::BorderEdge::Words);
-      }
+      });
+    std::size_t size = 0;
+    for (const std::vector<double>& part : parts)
+    {
+      size += part.size();
+    }
+    std::vector<double> packed;
+    packed.reserve(size);
+    for (const std::vector<double>& part : parts)
+    {
+      packed.insert(packed.end(), part.begin(), part.end());
     }
     return packed;
   }
@@ -936,7 +960,16 @@ private:
             // threads, share cache lines in `blocks`.
             Block block;
             const vtkIdType start = (batch + b) * blockSize;
-            for (vtkIdType v = start; v < std::min(this->NumVertices, start + blockSize); ++v)
+            const vtkIdType end = std::min(this->NumVertices, start + blockSize);
+            // A manifold row has one neighbour per corner: sized once, never grown.
+            block.Vertices.reserve(static_cast<std::size_t>(end - start));
+            block.Ends.reserve(static_cast<std::size_t>(end - start));
+            if (stencils)
+            {
+              block.Neighbours.reserve(
+                static_cast<std::size_t>(this->CornerOffsets[end] - this->CornerOffsets[start]));
+            }
+            for (vtkIdType v = start; v < end; ++v)
             {
               if (this->Numbering.Holding[v] != GlobalNumbering::Alone)
               {
