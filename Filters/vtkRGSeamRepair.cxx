@@ -687,8 +687,8 @@ public:
   /// Area-weighted vertex normals of the smoothed positions. Each vertex sums its triangles'
   /// area vectors in one order fixed by the mesh (by the triangles' sorted global ids), at its
   /// owner, so that the normals are the same to the bit for any number of ranks. Two exchanges,
-  /// three agreements; empty on failure.
-  std::vector<float> Normals(std::string& problem)
+  /// three agreements; the output's array "Normals", or null on failure.
+  vtkSmartPointer<vtkFloatArray> Normals(std::string& problem)
   {
     rgmc::LargeVector<double> sums;
     std::vector<std::vector<vtkIdType>> toOwners(this->AllRanks.Size);
@@ -704,10 +704,9 @@ public:
             this->ListSharedTerms(toOwners);
           }))
     {
-      return {};
+      return nullptr;
     }
     const auto received = this->AllRanks.Exchange(toOwners, this->Partners, NormalTag);
-    std::vector<float> normals;
     if (!this->AllRanks.Step("compute normals", problem,
           [&]()
           {
@@ -715,14 +714,29 @@ public:
             this->SumSharedTerms(received, sums);
           }))
     {
-      return {};
+      return nullptr;
     }
     rgmc::LargeVector<double>().swap(this->TriangleCross);
     this->Update(sums.data(), NormalBackTag);
-    if (!this->AllRanks.Step(
-          "compute normals", problem, [&]() { normals.assign(sums.begin(), sums.end()); }))
+    auto normals = vtkSmartPointer<vtkFloatArray>::New();
+    if (!this->AllRanks.Step("compute normals", problem,
+          [&]()
+          {
+            // Straight into the output's array, rounded to float on threads.
+            normals->SetName("Normals");
+            normals->SetNumberOfComponents(3);
+            float* out = rgmc::Allocate(normals.Get(), 3 * this->NumVertices);
+            rgmc::ParallelFor(3 * this->NumVertices, 3 * RowGrain,
+              [&](vtkIdType first, vtkIdType last)
+              {
+                for (vtkIdType i = first; i < last; ++i)
+                {
+                  out[i] = static_cast<float>(sums[i]);
+                }
+              });
+          }))
     {
-      return {};
+      return nullptr;
     }
     return normals;
   }
@@ -1878,10 +1892,10 @@ struct vtkRGSeamRepair::Run
   rgmc::VolumeBox box;    // the volume's, or the mesh's bounds when the input does not say
   Measures before, after; // before and after smoothing
   bool smooth = false;
-  std::vector<vtkIdType> connectivity; // the triangles over the vertices, when merged or copied
-  vtkNew<vtkPoints> points;            // the output's
-  std::vector<float> normals;          // after smoothing
-  Checks checks;                       // this rank's counts, then the sums over all ranks
+  std::vector<vtkIdType> connectivity;    // the triangles over the vertices, when merged or copied
+  vtkNew<vtkPoints> points;               // the output's
+  vtkSmartPointer<vtkFloatArray> normals; // after smoothing
+  Checks checks;                          // this rank's counts, then the sums over all ranks
   bool aborted = false;
 };
 
@@ -2144,7 +2158,7 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
       return false;
     }
     run.normals = repair.Normals(run.problem);
-    if ((run.normals.empty() && run.vertices.Count > 0) ||
+    if (!run.normals ||
       !MeasureSurface(ranks, repair, repair.Smoothed.data(), run.box, run.after, run.problem))
     {
       return false;
@@ -2241,11 +2255,7 @@ void vtkRGSeamRepair::BuildOutput(Run& run, vtkPolyData* output)
   pd->AddArray(ghosts);
   if (run.smooth)
   {
-    vtkNew<vtkFloatArray> normalArray;
-    normalArray->SetName("Normals");
-    normalArray->SetNumberOfComponents(3);
-    std::copy(run.normals.begin(), run.normals.end(), rgmc::Allocate(normalArray.Get(), 3 * n));
-    pd->SetNormals(normalArray);
+    pd->SetNormals(run.normals);
   }
 }
 
