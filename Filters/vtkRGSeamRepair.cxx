@@ -1077,11 +1077,10 @@ private:
     vtkIdType next[MaxFan], nextGid[MaxFan], previousGid[MaxFan];
     for (int i = 0; i < n; ++i)
     {
-      const vtkIdType c = static_cast<vtkIdType>(this->Corners[first + i]);
-      const vtkIdType t = c / 3, k = c % 3;
-      next[i] = static_cast<vtkIdType>(this->Triangles[3 * t + (k + 1) % 3]);
-      nextGid[i] = gid[next[i]];
-      previousGid[i] = gid[static_cast<vtkIdType>(this->Triangles[3 * t + (k + 2) % 3])];
+      const std::pair<vtkIdType, vtkIdType> ends = this->AroundCorner(this->Corners[first + i]);
+      next[i] = ends.first;
+      nextGid[i] = gid[ends.first];
+      previousGid[i] = gid[ends.second];
     }
     // rank[i]: how many next corners come before next[i]; distinct gids give distinct ranks.
     // matched: the next corners some previous corner equals.
@@ -1576,9 +1575,10 @@ private:
           around.clear();
           for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
           {
-            const vtkIdType t = this->Corners[c] / 3, k = this->Corners[c] % 3;
-            vtkIdType a = gid[static_cast<vtkIdType>(this->Triangles[3 * t + (k + 1) % 3])];
-            vtkIdType b = gid[static_cast<vtkIdType>(this->Triangles[3 * t + (k + 2) % 3])];
+            const vtkIdType t = this->Corners[c] / 3;
+            const std::pair<vtkIdType, vtkIdType> ends = this->AroundCorner(this->Corners[c]);
+            vtkIdType a = gid[ends.first];
+            vtkIdType b = gid[ends.second];
             if (b < a)
             {
               std::swap(a, b);
@@ -1666,6 +1666,15 @@ private:
     }
   }
 
+  /// The vertices after and before corner c (3 t + k) in triangle t's order: the ends of the
+  /// triangle's two edges at that corner.
+  std::pair<vtkIdType, vtkIdType> AroundCorner(I c) const
+  {
+    const vtkIdType t = static_cast<vtkIdType>(c) / 3, k = static_cast<vtkIdType>(c) % 3;
+    return { static_cast<vtkIdType>(this->Triangles[3 * t + (k + 1) % 3]),
+      static_cast<vtkIdType>(this->Triangles[3 * t + (k + 2) % 3]) };
+  }
+
   /// The ends of this rank's edges at vertex v (once per triangle side), as (gid, vertex)
   /// sorted by gid, into `out`. Reads only: threads may call it at once.
   void EndsAt(vtkIdType v, std::vector<std::pair<vtkIdType, vtkIdType>>& out) const
@@ -1673,10 +1682,9 @@ private:
     out.clear();
     for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
     {
-      const vtkIdType t = this->Corners[c] / 3, k = this->Corners[c] % 3;
-      for (vtkIdType other : { (k + 1) % 3, (k + 2) % 3 })
+      const std::pair<vtkIdType, vtkIdType> ends = this->AroundCorner(this->Corners[c]);
+      for (const vtkIdType w : { ends.first, ends.second })
       {
-        const vtkIdType w = static_cast<vtkIdType>(this->Triangles[3 * t + other]);
         out.emplace_back(this->Numbering.Gid[w], w);
       }
     }
