@@ -926,8 +926,9 @@ private:
   /// Vertices no other rank holds, in memory order: most are inside a closed manifold piece of
   /// the surface, where every edge has two triangles and the stencil is simply the neighbours
   /// in gid order. Those are found on threads, in blocks of vertices (each block's rows kept
-  /// apart), then taken block by block in order, the others going through AddVertex there: the
-  /// same rows, in the same order, for any number of threads.
+  /// apart), then taken block by block in order: room is made for a block of manifold rows
+  /// only, which threads then copy in; a block with other vertices is taken row by row, those
+  /// going through AddVertex. The same rows, in the same order, for any number of threads.
   void AddUnsharedVertices(bool stencils, Checks& checks)
   {
     if (vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
@@ -1000,9 +1001,27 @@ private:
             blocks[b] = std::move(block);
           }
         });
+      // A block without a vertex for AddVertex (nearly all) is copied into place on threads
+      // after this walk, which only makes room for it; the others are taken here, in order.
+      struct Placement
+      {
+        const Block* From;
+        std::size_t Row, Neighbour; // where its first row and its first neighbour go
+      };
+      std::vector<Placement> placements;
       for (Block& block : blocks)
       {
         checks.Edges += block.Edges;
+        if (stencils && block.Ends.size() == block.Vertices.size())
+        {
+          placements.push_back(
+            Placement{ &block, this->Owned.size(), this->Stencil.Neighbours.size() });
+          this->Owned.resize(this->Owned.size() + block.Vertices.size());
+          this->Stencil.Offsets.resize(this->Stencil.Offsets.size() + block.Ends.size());
+          this->Stencil.Neighbours.resize(
+            this->Stencil.Neighbours.size() + block.Neighbours.size());
+          continue;
+        }
         std::size_t row = 0;
         vtkIdType begin = 0;
         for (const vtkIdType entry : block.Vertices)
@@ -1021,8 +1040,25 @@ private:
           }
           begin = end;
         }
-        block = Block();
       }
+      rgmc::ParallelFor(static_cast<vtkIdType>(placements.size()), 1,
+        [&](vtkIdType first, vtkIdType last)
+        {
+          for (vtkIdType p = first; p < last; ++p)
+          {
+            const Placement& at = placements[p];
+            const Block& block = *at.From;
+            for (std::size_t r = 0; r < block.Vertices.size(); ++r)
+            {
+              this->Owned[at.Row + r] = static_cast<I>(block.Vertices[r]);
+              this->Stencil.Offsets[at.Row + r + 1] =
+                static_cast<std::int64_t>(at.Neighbour) + block.Ends[r];
+            }
+            std::copy(block.Neighbours.begin(), block.Neighbours.end(),
+              this->Stencil.Neighbours.begin() + at.Neighbour);
+          }
+        });
+      blocks.clear();
     }
   }
 
