@@ -278,26 +278,6 @@ private:
     return this->TileOf(i, j, k) * (TileWords * 64) + (x & 31) + 32 * ((y & 31) + 32 * (z & 31));
   }
 
-  /// Whether cube n and the 26 cubes around it lie in n's tile and are this rank's.
-  RGMC_INLINE bool InsideTile(const SurfaceNode& n) const
-  {
-    if (!this->Volume.Owned.Overlaps().empty())
-    {
-      return false;
-    }
-    const CellBox& b = this->Volume.Owned.Mine();
-    const int c[3] = { n.I, n.J, n.K };
-    for (int a = 0; a < 3; ++a)
-    {
-      const int x = (c[a] - b.Lo[a]) & (TileCubes - 1);
-      if (x == 0 || x == TileCubes - 1 || c[a] >= b.Hi[a])
-      {
-        return false;
-      }
-    }
-    return true;
-  }
-
   RGMC_INLINE bool AllFound(std::int64_t bit) const
   {
     return (this->Visited[bit >> 6] >> (bit & 63)) & 1u;
@@ -390,9 +370,9 @@ private:
   /// (unless `keepInTile`: then they are left to their own tile's scan).
   void Expand(std::int64_t tile, const SurfaceNode& n, bool keepInTile)
   {
-    if (!n.Degenerate && this->InsideTile(n))
+    if (!n.Degenerate && this->Volume.Owned.Overlaps().empty())
     {
-      this->ExpandInside(tile, n);
+      this->ExpandByTable(tile, n, keepInTile);
       return;
     }
     TileWork& w = this->Work[tile];
@@ -437,27 +417,58 @@ private:
       });
   }
 
-  /// Expand for a node of a cube without a degenerate sample whose neighbours all lie in its
-  /// tile (the common case): the same visits in the same order, the neighbours' found-bits at
-  /// fixed offsets from the node's and a vertex's key made only when a visit needs it.
-  RGMC_INLINE void ExpandInside(std::int64_t tile, const SurfaceNode& n)
+  /// Expand for a node of a cube without a degenerate sample, on a rank whose owned cubes are
+  /// its box (the common case): the same steps in the same order, taken from the node's sheet
+  /// edges and EdgeNeighbourTable. A neighbour in the node's tile is found at a fixed offset of
+  /// the node's found-bit, the vertex's key made only when the neighbour is visited; one outside
+  /// it (another tile's, or no owned cube) is handled as Expand does.
+  RGMC_INLINE void ExpandByTable(std::int64_t tile, const SurfaceNode& n, bool keepInTile)
   {
     TileWork& w = this->Work[tile];
+    const CellBox& b = this->Volume.Owned.Mine();
     const std::int64_t bit = this->CubeBit(n.I, n.J, n.K);
+    // The steps along each axis that stay in the tile (and the owned box): from lo to hi.
+    const int c[3] = { n.I, n.J, n.K };
+    int lo[3], hi[3];
+    bool inside = true;
+    for (int a = 0; a < 3; ++a)
+    {
+      const int x = (c[a] - b.Lo[a]) & (TileCubes - 1);
+      lo[a] = x > 0 ? -1 : 0;
+      hi[a] = x < TileCubes - 1 && c[a] < b.Hi[a] ? 1 : 0;
+      inside = inside && lo[a] < 0 && hi[a] > 0;
+    }
     for (unsigned edges = this->Volume.Table[n.Case].SheetEdges[n.Node]; edges; edges &= edges - 1)
     {
       const int e = __builtin_ctz(edges);
+      const int* p = CornerOffset[EdgeCorners[e][0]];
+      auto key = [&]()
+      { return this->Volume.GridOf.EdgeKey(n.I + p[0], n.J + p[1], n.K + p[2], CubeEdgeAxis[e]); };
       for (const EdgeNeighbour& nb : EdgeNeighbourTable[e])
       {
-        if (this->AllFound(bit + nb.Offset[0] + 32 * nb.Offset[1] + 1024 * nb.Offset[2]))
+        const std::int8_t* o = nb.Offset;
+        const int i = n.I + o[0], j = n.J + o[1], k = n.K + o[2];
+        if (inside ||
+          (o[0] >= lo[0] && o[0] <= hi[0] && o[1] >= lo[1] && o[1] <= hi[1] && o[2] >= lo[2] &&
+            o[2] <= hi[2]))
         {
-          continue;
+          if (!this->AllFound(bit + o[0] + 32 * o[1] + 1024 * o[2]))
+          {
+            this->Visit(w, i, j, k, key(), nb.Edge, n.Component, nullptr);
+          }
         }
-        const int* p = CornerOffset[EdgeCorners[e][0]];
-        const std::int64_t key =
-          this->Volume.GridOf.EdgeKey(n.I + p[0], n.J + p[1], n.K + p[2], CubeEdgeAxis[e]);
-        this->Visit(w, n.I + nb.Offset[0], n.J + nb.Offset[1], n.K + nb.Offset[2], key, nb.Edge,
-          n.Component, nullptr);
+        else if (!this->Volume.Owned.Owns(i, j, k))
+        {
+          // Owned cubes lie inside the volume; one of another rank is a departure.
+          if (this->CrossRanks && this->Volume.GridOf.HasCell(i, j, k))
+          {
+            w.Departures.push_back(Departure{ key(), n.Component });
+          }
+        }
+        else if (!keepInTile)
+        {
+          w.Outbox.push_back(Crossing{ key(), i, j, k, n.Component, nb.Edge });
+        }
       }
     }
   }
