@@ -656,6 +656,39 @@ public:
   {
     const std::int64_t base = this->GridOf.LocalIndex(i0, j, k);
     const double c = this->Options.Isovalue;
+    if constexpr (std::is_integral<ValueType>::value && sizeof(ValueType) <= 4 &&
+      std::is_lvalue_reference<decltype(std::declval<const Values&>()[0])>::value)
+    {
+      // Integers of up to 32 bits are exact in double: s >= c exactly when s >= ceil(c), which
+      // is compared in the samples' own type, a row at a time (the compiler vectorizes it).
+      notNumber = 0;
+      const double t = std::ceil(c);
+      if (!(t <= static_cast<double>(std::numeric_limits<ValueType>::max())))
+      {
+        above = 0; // c above every sample, or NaN (nothing is >= NaN)
+        return;
+      }
+      const std::uint64_t all = n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1;
+      if (t <= static_cast<double>(std::numeric_limits<ValueType>::min()))
+      {
+        above = all;
+        return;
+      }
+      const ValueType threshold = static_cast<ValueType>(t);
+      const ValueType* row = &this->Samples[base];
+      unsigned char at[64];
+      for (int b = 0; b < n; ++b)
+      {
+        at[b] = row[b] >= threshold;
+      }
+      std::uint64_t a = 0;
+      for (int b = 0; b < n; ++b)
+      {
+        a |= static_cast<std::uint64_t>(at[b]) << b;
+      }
+      above = a;
+      return;
+    }
     std::uint64_t a = 0, x = 0;
     for (int b = 0; b < n; ++b)
     {

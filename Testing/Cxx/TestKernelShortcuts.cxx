@@ -1,6 +1,7 @@
 // The kernel's shortcuts against what they stand for, without VTK's filters:
 //   - ClassifyRow (the full scan's classification of grid points) against Evaluate's case bits
-//     and its NaN test, on every row, start and length of float and int16 fields;
+//     and its NaN test, on every row, start and length of float and integer fields, at integer
+//     and fractional isovalues, isovalues beyond the samples' type and NaN;
 //   - EdgeNeighbourTable (growth's fixed steps to the cubes around an edge) against
 //     ForCubesAround, in the same order, and the neighbour's edge being the same edge;
 //   - the full scan (GrowAll) finding exactly the cubes that have surface nodes, counted by
@@ -20,6 +21,7 @@
 #include <limits>
 #include <set>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 namespace
@@ -42,7 +44,8 @@ struct Random
   }
 };
 
-/// Blobs rounded to integers (many samples equal the isovalue 3), with a few NaN when asked.
+/// Blobs rounded to integers (many samples equal the isovalue 3; raised by 16 for an unsigned
+/// type), with a few NaN when asked.
 template <typename T>
 std::vector<T> Field(const int n[3], bool withNaN)
 {
@@ -54,8 +57,12 @@ std::vector<T> Field(const int n[3], bool withNaN)
     {
       for (int i = 0; i < n[0]; ++i)
       {
-        const double v =
+        double v =
           5 * std::sin(0.31 * i) * std::cos(0.23 * j) + 4 * std::sin(0.19 * k) + 2 * random.Next();
+        if (std::is_unsigned<T>::value)
+        {
+          v += 16; // no negative values for an unsigned type
+        }
         values[i + n[0] * (j + n[1] * static_cast<std::size_t>(k))] = static_cast<T>(std::round(v));
       }
     }
@@ -90,11 +97,12 @@ struct Piece
 };
 
 template <typename T>
-void CheckClassifyRow(const char* what, bool withNaN)
+void CheckClassifyRow(const char* what, bool withNaN, double isovalue = 3.0)
 {
   const int n[3] = { 70, 9, 7 };
   const std::vector<T> values = Field<T>(n, withNaN);
-  const Piece piece(n);
+  Piece piece(n);
+  piece.Options.Isovalue = isovalue;
   const rgmc::Grid& grid = piece.GridOf;
   const rgmc::Ownership& own = piece.Owned;
   const rgmc::SurfaceOptions& options = piece.Options;
@@ -275,6 +283,17 @@ int main()
 {
   CheckClassifyRow<float>("float samples with NaN", true);
   CheckClassifyRow<short>("int16 samples", false);
+  // Integer samples are classified in their own type, against the isovalue rounded up: between
+  // two integers, beyond the type's range at either end, and NaN (no sample is above it).
+  CheckClassifyRow<short>("int16 samples, isovalue 2.5", false, 2.5);
+  CheckClassifyRow<short>("int16 samples, isovalue -2.5", false, -2.5);
+  CheckClassifyRow<short>("int16 samples, isovalue -40000", false, -40000.0);
+  CheckClassifyRow<short>("int16 samples, isovalue 40000", false, 40000.0);
+  CheckClassifyRow<short>(
+    "int16 samples, isovalue NaN", false, std::numeric_limits<double>::quiet_NaN());
+  CheckClassifyRow<unsigned char>("uint8 samples, isovalue 19.5", false, 19.5);
+  CheckClassifyRow<int>("int32 samples, isovalue -0.5", false, -0.5);
+  CheckClassifyRow<long long>("int64 samples (compared in double)", false, 2.5);
   CheckEdgeNeighbours();
   // Partial tiles (70 = 2 x 32 + 6 points), more than one tile along each axis.
   const int n[3] = { 70, 45, 38 };
