@@ -3,6 +3,8 @@
 #ifndef rgmcRadixSort_h
 #define rgmcRadixSort_h
 
+#include "rgmcBuffer.h"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -66,6 +68,46 @@ void RadixSort(Vector& values, KeyOf&& keyOf)
   {
     values.swap(buffer);
   }
+}
+
+/// Sorts the pairs (keyAt(i), i), 0 <= i < n, by key and then index (std::sort's order on the
+/// pairs), and calls put(rank, key, index) for each in that order, when every key fits above the
+/// bits of the largest index in one 64-bit word: each pair is then sorted as that one word, half
+/// the bytes a radix pass moves of 16-byte pairs. Returns false, having called nothing, when a
+/// key does not fit (the caller sorts its pairs with RadixSort).
+template <typename KeyAt, typename Put>
+bool RadixSortPacked(std::size_t n, KeyAt&& keyAt, Put&& put)
+{
+  int indexBits = 0;
+  while (indexBits < 64 && (std::uint64_t(1) << indexBits) < n)
+  {
+    ++indexBits;
+  }
+  if (indexBits == 64)
+  {
+    return false;
+  }
+  const std::uint64_t largestKey = ~std::uint64_t(0) >> indexBits;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (keyAt(i) > largestKey)
+    {
+      return false;
+    }
+  }
+  LargeVector<std::uint64_t> packed(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    packed[i] = keyAt(i) << indexBits | i;
+  }
+  // Only the key's bits are sorted on: the indices increase in the input, and the sort is stable.
+  RadixSort(packed, [indexBits](std::uint64_t word) { return word >> indexBits; });
+  const std::uint64_t indexMask = (std::uint64_t(1) << indexBits) - 1;
+  for (std::size_t r = 0; r < n; ++r)
+  {
+    put(r, packed[r] >> indexBits, static_cast<std::size_t>(packed[r] & indexMask));
+  }
+  return true;
 }
 
 } // namespace rgmc

@@ -1,6 +1,7 @@
-// Unit test of rgmc::RadixSort against std::sort: (key, index) records come out as std::sort on
-// the pairs gives them, for keys that differ in few or many bytes, with many equal keys, and for
-// keys whose top bits are set (unsigned order).
+// Unit test of rgmc::RadixSort and rgmc::RadixSortPacked against std::sort: (key, index) records
+// come out as std::sort on the pairs gives them, for keys that differ in few or many bytes, with
+// many equal keys, and for keys whose top bits are set (unsigned order); the packed sort runs
+// exactly when every key fits above the indices' bits.
 #include "rgmcCheck.h"
 #include "rgmcRadixSort.h"
 
@@ -25,6 +26,23 @@ void Check(const std::vector<std::uint64_t>& keys, const char* what)
   std::sort(expected.begin(), expected.end());
   rgmc::RadixSort(sorted, [](const Record& r) { return r.first; });
   RGMC_CHECK(sorted == expected, what << ": " << keys.size() << " keys");
+  // Packed with the indices when every key fits above them; refused otherwise.
+  int indexBits = 0;
+  while ((std::uint64_t(1) << indexBits) < keys.size())
+  {
+    ++indexBits;
+  }
+  const bool fits = std::all_of(keys.begin(), keys.end(),
+    [indexBits](std::uint64_t k) { return k <= (~std::uint64_t(0) >> indexBits); });
+  std::vector<Record> packed(keys.size(), Record(0, -1));
+  const bool done = rgmc::RadixSortPacked(
+    keys.size(), [&keys](std::size_t i) { return keys[i]; },
+    [&packed](std::size_t r, std::uint64_t key, std::size_t i)
+    { packed[r] = Record(key, static_cast<std::int64_t>(i)); });
+  RGMC_CHECK(done == fits,
+    what << ": " << keys.size() << " keys " << (fits ? "fit" : "do not fit") << " above "
+         << indexBits << " index bits, but the packed sort " << (done ? "ran" : "refused"));
+  RGMC_CHECK(!done || packed == expected, what << ": " << keys.size() << " keys, packed");
 }
 
 } // namespace
@@ -61,6 +79,17 @@ int main()
     Check(keys, "sorted keys");
     std::reverse(keys.begin(), keys.end());
     Check(keys, "reversed keys");
+  }
+  // Keys just below and just above the room the indices leave (300 000 indices: 19 bits).
+  for (std::uint64_t top : { ~std::uint64_t(0) >> 19, (~std::uint64_t(0) >> 19) + 1 })
+  {
+    std::vector<std::uint64_t> keys(300000);
+    for (auto& k : keys)
+    {
+      k = random() % (top + 1);
+    }
+    keys[12345] = top;
+    Check(keys, "keys at the packed sort's limit");
   }
   // Keys equal in every byte but one, in each position.
   for (int b = 0; b < 8; ++b)
