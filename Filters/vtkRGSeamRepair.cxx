@@ -118,8 +118,8 @@ LocalVertices MergeLocal(
   const vtkIdType n = input->GetNumberOfPoints();
   rgmc::LargeVector<std::pair<Identity<Words>, vtkIdType>> all(static_cast<std::size_t>(n));
   // One-word identities (the keys) are sorted packed with their points, one word each, where
-  // both fit in 64 bits: a key takes about log2 of 3 x the grid points, a point index log2 of
-  // the points (a 2048^3 volume leaves room for 500 million points).
+  // both fit in 64 bits: a key takes log2 of 4 x the grid points (edge keys, then point keys), an
+  // index log2 of the points (a 2048^3 volume leaves room for 500 million points).
   bool packed = false;
   if constexpr (Words == 1)
   {
