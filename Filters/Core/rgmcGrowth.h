@@ -394,27 +394,37 @@ private:
             {
               return;
             }
-            if (!own.Owns(i, j, k))
-            {
-              // Owned cubes lie inside the volume; one of another rank is a departure.
-              if (this->CrossRanks && this->Volume.GridOf.HasCell(i, j, k))
-              {
-                w.Departures.push_back(Departure{ v.Key, n.Component });
-              }
-              return;
-            }
-            const std::int64_t to = this->TileOf(i, j, k);
-            if (to == tile)
+            if (own.Owns(i, j, k) && this->TileOf(i, j, k) == tile)
             {
               this->Visit(w, i, j, k, v.Key, edge, n.Component, nullptr);
             }
-            else if (!keepInTile)
+            else
             {
-              w.Outbox.push_back(
-                Crossing{ v.Key, i, j, k, n.Component, static_cast<std::int8_t>(edge) });
+              this->StepOutOfTile(w, i, j, k, v.Key, edge, n.Component, keepInTile);
             }
           });
       });
+  }
+
+  /// A step of component `comp` to cube (i, j, k) for vertex `key` (on the cube's edge `edge`)
+  /// that leaves the expanding node's tile: to another tile of this rank, a crossing (unless
+  /// `keepInTile`); to another rank's cube, a departure (when CrossRanks); outside the volume,
+  /// nothing.
+  RGMC_INLINE void StepOutOfTile(
+    TileWork& w, int i, int j, int k, std::int64_t key, int edge, int comp, bool keepInTile)
+  {
+    if (!this->Volume.Owned.Owns(i, j, k))
+    {
+      // Owned cubes lie inside the volume; one of another rank is a departure.
+      if (this->CrossRanks && this->Volume.GridOf.HasCell(i, j, k))
+      {
+        w.Departures.push_back(Departure{ key, comp });
+      }
+    }
+    else if (!keepInTile)
+    {
+      w.Outbox.push_back(Crossing{ key, i, j, k, comp, static_cast<std::int8_t>(edge) });
+    }
   }
 
   /// Expand for a node of a cube without a degenerate sample, on a rank whose owned cubes are
@@ -457,17 +467,9 @@ private:
             this->Visit(w, i, j, k, key(), nb.Edge, n.Component, nullptr);
           }
         }
-        else if (!this->Volume.Owned.Owns(i, j, k))
+        else
         {
-          // Owned cubes lie inside the volume; one of another rank is a departure.
-          if (this->CrossRanks && this->Volume.GridOf.HasCell(i, j, k))
-          {
-            w.Departures.push_back(Departure{ key(), n.Component });
-          }
-        }
-        else if (!keepInTile)
-        {
-          w.Outbox.push_back(Crossing{ key(), i, j, k, n.Component, nb.Edge });
+          this->StepOutOfTile(w, i, j, k, key(), nb.Edge, n.Component, keepInTile);
         }
       }
     }

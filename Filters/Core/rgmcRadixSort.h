@@ -88,17 +88,15 @@ bool RadixSortPacked(std::size_t n, KeyAt&& keyAt, Put&& put)
     return false;
   }
   const std::uint64_t largestKey = ~std::uint64_t(0) >> indexBits;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    if (keyAt(i) > largestKey)
-    {
-      return false;
-    }
-  }
   LargeVector<std::uint64_t> packed(n);
   for (std::size_t i = 0; i < n; ++i)
   {
-    packed[i] = keyAt(i) << indexBits | i;
+    const std::uint64_t key = keyAt(i);
+    if (key > largestKey)
+    {
+      return false;
+    }
+    packed[i] = key << indexBits | i;
   }
   // Only the key's bits are sorted on: the indices increase in the input, and the sort is stable.
   RadixSort(packed, [indexBits](std::uint64_t word) { return word >> indexBits; });
