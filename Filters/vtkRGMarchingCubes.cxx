@@ -1266,7 +1266,19 @@ bool vtkRGMarchingCubes::StoreSurface(Run& run, vtkPolyData* output)
       const rgmc::Decision& decision = run.decision;
       const std::vector<int>& rootIndex = run.graph.RootIndex;
       rgmc::LocalMesh& mesh = run.kernel->Mesh();
-      mesh.Compact([&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; });
+      // Where this rank keeps every component it has (All Components; Seeded, which grows only
+      // what the seeds reach unless MaximumGrowthRounds was passed), there is nothing to compact:
+      // every point is a corner of a triangle, and Compact would rewrite the same arrays.
+      auto kept = [&](int comp) { return decision.FinalId[rootIndex[comp]] >= 0; };
+      bool dropsAny = false;
+      for (int comp = 0; comp < static_cast<int>(rootIndex.size()) && !dropsAny; ++comp)
+      {
+        dropsAny = !kept(comp);
+      }
+      if (dropsAny)
+      {
+        mesh.Compact(kept);
+      }
       const vtkIdType numPoints = mesh.NumberOfPoints();
       const vtkIdType numKept = mesh.NumberOfTriangles();
       for (std::int32_t& comp : mesh.TriangleComponent)
