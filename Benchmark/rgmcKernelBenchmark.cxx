@@ -136,6 +136,43 @@ Volume NoisyHead(int size)
   return v;
 }
 
+/// A dense surface, to measure the cost of a triangle rather than of a scan: an int16 gyroid,
+/// 1000 (sin x cos y + sin y cos z + sin z cos x) with `period` voxels per cell, at 0.5 (no
+/// sample equals it). Its level set is one connected surface through the whole volume, about
+/// 0.6 triangles a voxel at period 16, so a seed anywhere on it selects nearly every triangle
+/// vtkFlyingEdges3D makes.
+Volume Gyroid(int size, double period)
+{
+  Volume v{ "gyroid" + std::to_string(size), vtkSmartPointer<vtkImageData>::New(), 0.5,
+    { 0, 0, 0 } };
+  vtkImageData* image = v.Image;
+  image->SetDimensions(size, size, size);
+  vtkNew<vtkShortArray> values;
+  values->SetName("Gyroid");
+  values->SetNumberOfTuples(static_cast<vtkIdType>(size) * size * size);
+  const double w = 2.0 * M_PI / period;
+  for (int k = 0; k < size; ++k)
+  {
+    for (int j = 0; j < size; ++j)
+    {
+      for (int i = 0; i < size; ++i)
+      {
+        const double x = w * (i + 0.25), y = w * (j + 0.5), z = w * (k + 0.125);
+        const double g =
+          std::sin(x) * std::cos(y) + std::sin(y) * std::cos(z) + std::sin(z) * std::cos(x);
+        values->SetValue(i + static_cast<vtkIdType>(size) * (j + static_cast<vtkIdType>(size) * k),
+          static_cast<short>(std::lround(1000.0 * g)));
+      }
+    }
+  }
+  image->GetPointData()->SetScalars(values);
+  for (int a = 0; a < 3; ++a)
+  {
+    v.Seed[a] = 0.5 * (size - 1); // the surface passes within period / 2 of any point
+  }
+  return v;
+}
+
 const rgmc::CaseTable& Table()
 {
   static const rgmc::CaseTable table(&vtkMarchingCubesTriangleCases::GetCases()[0].edges[0]);
@@ -239,16 +276,61 @@ double FlyingEdgesSeconds(const Volume& v, int repeats, long long& triangles)
   return seconds;
 }
 
+/// vtkFlyingEdges3D's time, about, for its scan of the volume alone: at half a unit below the
+/// largest sample, within the data's range (it passes over every row) but with a surface only
+/// in the few cubes at the peaks.
+double FlyingEdgesScanSeconds(const Volume& v, int repeats, long long& triangles)
+{
+  Volume peaks = v;
+  peaks.Isovalue = v.Image->GetPointData()->GetScalars()->GetRange()[1] - 0.5;
+  return FlyingEdgesSeconds(peaks, repeats, triangles);
+}
+
 double Ns(double seconds, long long triangles)
 {
   return triangles > 0 ? 1e9 * seconds / static_cast<double>(triangles) : 0.0;
+}
+
+/// The cost of a triangle on the dense surface, at the current thread count, as JSON: Flying
+/// Edges' own (its time minus its time at an isovalue only the peaks' samples reach, which is
+/// about its scan of the volume alone, per triangle more) against the seeded kernel's and
+/// filter's (which read only the cubes the surface passes through: all their time counts).
+std::string DenseRun(const Volume& v, int threads, int repeats)
+{
+  long long feTriangles = 0, noTriangles = 0, seededTriangles = 0;
+  const double fe = FlyingEdgesSeconds(v, repeats, feTriangles);
+  const double scan = FlyingEdgesScanSeconds(v, repeats, noTriangles);
+  const Stages stages = KernelStages(v, true, repeats);
+  const double seeded = FilterSeconds(v, vtkRGMarchingCubes::SEEDED, repeats, seededTriangles);
+  const double feOwn = Ns(fe - scan, feTriangles - noTriangles);
+  const double kernel = Ns(stages.Seed + stages.Growth + stages.Extraction, stages.Triangles);
+  std::ostringstream json;
+  json << "{\"volume\": \"" << v.Name << "\", \"threads\": " << threads
+       << ", \"flying_edges\": " << fe << ", \"flying_edges_scan\": " << scan
+       << ", \"flying_edges_triangles\": " << feTriangles
+       << ", \"flying_edges_scan_triangles\": " << noTriangles
+       << ", \"flying_edges_own_ns_per_triangle\": " << feOwn << ", \"seeded\": " << seeded
+       << ", \"seeded_triangles\": " << seededTriangles
+       << ", \"seeded_ns_per_triangle\": {\"growth\": " << Ns(stages.Growth, stages.Triangles)
+       << ", \"extraction\": " << Ns(stages.Extraction, stages.Triangles)
+       << ", \"kernel\": " << kernel << ", \"total\": " << Ns(seeded, seededTriangles)
+       << "}, \"seeded_vs_flying_edges_own\": " << Ns(seeded, seededTriangles) / feOwn
+       << ", \"seeded_kernel_vs_flying_edges_own\": " << kernel / feOwn << "}";
+  std::cerr << v.Name << ", " << threads << " thread(s): flying edges " << fe << " s ("
+            << feTriangles << " triangles), its scan alone " << scan << " s (" << noTriangles
+            << " triangles): " << feOwn << " ns/triangle of its own; seeded " << seeded << " s ("
+            << seededTriangles << " triangles, " << Ns(seeded, seededTriangles)
+            << " ns/triangle; kernel " << kernel << ": growth "
+            << Ns(stages.Growth, stages.Triangles) << ", extraction "
+            << Ns(stages.Extraction, stages.Triangles) << ")\n";
+  return json.str();
 }
 
 } // namespace
 
 int main(int argc, char* argv[])
 {
-  int size = 512, ctSize = 384, repeats = 5;
+  int size = 512, ctSize = 384, denseSize = 256, repeats = 5;
   std::vector<int> threadCounts = { 1, 2 };
   std::string only;
   for (int a = 1; a + 1 < argc; a += 2)
@@ -261,6 +343,10 @@ int main(int argc, char* argv[])
     else if (arg == "--ct-size")
     {
       ctSize = std::atoi(argv[a + 1]);
+    }
+    else if (arg == "--dense-size")
+    {
+      denseSize = std::atoi(argv[a + 1]);
     }
     else if (arg == "--repeats")
     {
@@ -277,8 +363,8 @@ int main(int argc, char* argv[])
     }
     else
     {
-      std::cerr << "usage: rgmcKernelBenchmark [--size N] [--ct-size N] [--threads 1,2] "
-                   "[--repeats N] [--only seeded|all]\n";
+      std::cerr << "usage: rgmcKernelBenchmark [--size N] [--ct-size N] [--dense-size N] "
+                   "[--threads 1,2] [--repeats N] [--only seeded|all]\n";
       return 2;
     }
   }
@@ -318,7 +404,10 @@ int main(int argc, char* argv[])
             return;
           }
           long long feTriangles = 0, seededTriangles = 0, largestTriangles = 0, allTriangles = 0;
+          long long peakTriangles = 0;
           const double fe = FlyingEdgesSeconds(v, repeats, feTriangles);
+          const double scan = FlyingEdgesScanSeconds(v, repeats, peakTriangles);
+          const double feOwn = Ns(fe - scan, feTriangles - peakTriangles);
           const Stages seededStages = KernelStages(v, true, repeats);
           const Stages allStages = KernelStages(v, false, repeats);
           const double seeded =
@@ -347,16 +436,20 @@ int main(int argc, char* argv[])
                << ", \"rest\": " << Ns(allRest, allTriangles)
                << ", \"total\": " << Ns(all, allTriangles)
                << "}, \"flying_edges_ns_per_triangle\": " << Ns(fe, feTriangles)
+               << ", \"flying_edges_scan\": " << scan
+               << ", \"flying_edges_scan_triangles\": " << peakTriangles
+               << ", \"flying_edges_own_ns_per_triangle\": " << feOwn
+               << ", \"seeded_vs_flying_edges_own\": " << Ns(seeded, seededTriangles) / feOwn
                << ", \"seeded_vs_flying_edges\": " << seeded / fe
                << ", \"largest_vs_flying_edges\": " << largest / fe
                << ", \"all_vs_flying_edges\": " << all / fe << "}";
           firstRun = false;
           std::cerr << v.Name << ", " << threads << " thread(s): flying edges " << fe << " s ("
-                    << feTriangles << " triangles, " << Ns(fe, feTriangles)
-                    << " ns/triangle); seeded " << seeded << " s (" << seededTriangles
-                    << " triangles, " << Ns(seeded, seededTriangles) << " ns/triangle: seed "
-                    << Ns(seededStages.Seed, seededTriangles) << ", growth "
-                    << Ns(seededStages.Growth, seededTriangles) << ", extraction "
+                    << feTriangles << " triangles, " << Ns(fe, feTriangles) << " ns/triangle, "
+                    << feOwn << " of its own beyond its scan, " << scan << " s); seeded " << seeded
+                    << " s (" << seededTriangles << " triangles, " << Ns(seeded, seededTriangles)
+                    << " ns/triangle: seed " << Ns(seededStages.Seed, seededTriangles)
+                    << ", growth " << Ns(seededStages.Growth, seededTriangles) << ", extraction "
                     << Ns(seededStages.Extraction, seededTriangles) << ", rest "
                     << Ns(seededRest, seededTriangles) << "), " << seeded / fe
                     << "x flying edges; largest " << largest << " s (" << largest / fe << "x); all "
@@ -364,6 +457,21 @@ int main(int argc, char* argv[])
                     << Ns(allStages.Growth, allTriangles) << ", extraction "
                     << Ns(allStages.Extraction, allTriangles) << ", rest "
                     << Ns(allRest, allTriangles) << " ns/triangle)\n";
+        });
+    }
+  }
+  json << "\n  ],\n  \"dense\": [";
+  if (denseSize > 0 && only.empty())
+  {
+    const Volume dense = Gyroid(denseSize, 16.0);
+    bool first = true;
+    for (const int threads : threadCounts)
+    {
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]()
+        {
+          json << (first ? "" : ",") << "\n    " << DenseRun(dense, threads, repeats);
+          first = false;
         });
     }
   }

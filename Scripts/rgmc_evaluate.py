@@ -38,7 +38,9 @@ threads (STDThread): the CT phantom (512^3, seeded on the skull) and a noisy CT-
 by the program (384^3 int16, a skull shell, a separate head holder, noise of about 40 HU), each
 in Seeded, Largest Component and All Components mode against vtkFlyingEdges3D in the same run,
 with the kernel's stages (seed search, growth, extraction, the rest of the filter) in ns per
-output triangle; then the GUI's case, Scripts/rgmc_slider.py in pvpython: the median time from
+output triangle; a dense surface (an int16 gyroid, 256^3, about 10 M triangles) for the cost of
+a triangle against Flying Edges' own (its time minus its scan of the volume alone); then the
+GUI's case, Scripts/rgmc_slider.py in pvpython: the median time from
 a new Isovalue to the updated seeded surface over 20 changes, against ParaView's Contour, with
 pvpython's own threads and with 2 STDThread threads. Writes kernel.md and kernel.json.
 
@@ -461,8 +463,8 @@ def threads_report(result, args):
 
 def run_kernel(args):
     command = [args.kernel_binary, "--size", str(args.threads_size), "--ct-size",
-               str(args.kernel_ct_size), "--threads", args.thread_counts, "--repeats",
-               str(args.kernel_repeats)]
+               str(args.kernel_ct_size), "--dense-size", str(args.kernel_dense_size),
+               "--threads", args.thread_counts, "--repeats", str(args.kernel_repeats)]
     result = run_json(command, "rgmcKernelBenchmark")
     result["slider"] = []
     plugin = rgmc_common.find_plugin()
@@ -506,6 +508,33 @@ def kernel_report(result, args):
         "%s: FE %d, seeded %d, All %d, FE %.0f ns/triangle" % (
             r["volume"], r["flying_edges_triangles"], r["seeded_triangles"], r["all_triangles"],
             r["flying_edges_ns_per_triangle"]) for r in runs if r["threads"] == runs[0]["threads"]), ""]
+    lines += ["The cost of a triangle against Flying Edges' own: FE's time minus its time at half "
+              "a unit below the largest sample (its scan of the volume, with a surface only at the "
+              "peaks), per triangle more; the seeded filter's and kernel's whole time per triangle "
+              "(they read only the cubes the surface passes through). The gyroid (int16, period 16 "
+              "voxels) is one dense connected surface: the seed selects all of it, and FE's scan is "
+              "a few percent of its time.", "",
+              "| volume | threads | FE (s) | FE scan (s) | FE own ns/triangle | seeded filter "
+              "ns/triangle | filter / FE own | seeded kernel ns/triangle: growth, extraction = total "
+              "| kernel / FE own |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in runs:
+        ns = r["seeded_ns_per_triangle"]
+        lines.append("| %s | %d | %.3f | %.3f | %.0f | %.0f | %.2f | %.0f, %.0f = %.0f | %.2f |" % (
+            r["volume"], r["threads"], r["flying_edges"], r["flying_edges_scan"],
+            r["flying_edges_own_ns_per_triangle"], ns["total"], r["seeded_vs_flying_edges_own"],
+            ns["growth"], ns["extraction"], ns["seed"] + ns["growth"] + ns["extraction"],
+            (ns["seed"] + ns["growth"] + ns["extraction"]) / r["flying_edges_own_ns_per_triangle"]))
+    for r in result.get("dense", []):
+        ns = r["seeded_ns_per_triangle"]
+        lines.append("| %s | %d | %.3f | %.3f | %.0f | %.0f | %.2f | %.0f, %.0f = %.0f | %.2f |" % (
+            r["volume"], r["threads"], r["flying_edges"], r["flying_edges_scan"],
+            r["flying_edges_own_ns_per_triangle"], ns["total"], r["seeded_vs_flying_edges_own"],
+            ns["growth"], ns["extraction"], ns["kernel"], r["seeded_kernel_vs_flying_edges_own"]))
+    if result.get("dense"):
+        lines += ["", "Triangles: " + "; ".join(
+            "%s: FE %d, seeded %d" % (r["volume"], r["flying_edges_triangles"], r["seeded_triangles"])
+            for r in result["dense"] if r["threads"] == result["dense"][0]["threads"])]
+    lines.append("")
     if result.get("slider"):
         lines += ["The GUI's case (Scripts/rgmc_slider.py in pvpython, the phantom at %d^3): the time "
                   "from a new Isovalue to the updated surface, median of %d changes between 300 and "
@@ -698,6 +727,8 @@ def main(argv):
     parser.add_argument("--kernel", action="store_true",
                         help="the kernel benchmark instead (rgmcKernelBenchmark and the slider, one rank)")
     parser.add_argument("--kernel-ct-size", type=int, default=384, help="the noisy head's points per axis")
+    parser.add_argument("--kernel-dense-size", type=int, default=256,
+                        help="the dense gyroid's points per axis (0: none)")
     parser.add_argument("--kernel-repeats", type=int, default=5)
     parser.add_argument("--slider-changes", type=int, default=20,
                         help="isovalue changes of the slider measurement (0: none)")
