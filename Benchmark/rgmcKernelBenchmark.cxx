@@ -9,11 +9,15 @@
 //     output arrays) in Seeded, Largest and All modes; "rest" is the filter's time minus the
 //     kernel's stages (the checks, the decision, the output arrays): measured in separate runs,
 //     it is a small difference of two minima and can come out slightly negative;
-//   - vtkFlyingEdges3D with normals, the same isovalue.
+//   - vtkFlyingEdges3D with normals, the same isovalue, and again half a unit below the largest
+//     sample (its scan of the volume; a surface only at the peaks): its time beyond the scan,
+//     per triangle, is Flying Edges' own cost of a triangle, set against the seeded filter's.
+// Then a dense surface (an int16 gyroid, --dense-size points per axis, 0 for none), where a
+// triangle is all there is to pay for: the same comparison, seeded against Flying Edges' own.
 // Minimum of the repeats; JSON on stdout, a summary on stderr.
 //
-//   rgmcKernelBenchmark [--size 512] [--ct-size 384] [--threads 1,2] [--repeats 5]
-//                       [--only seeded|all]
+//   rgmcKernelBenchmark [--size 512] [--ct-size 384] [--dense-size 256] [--threads 1,2]
+//                       [--repeats 5] [--only seeded|all]
 // --only runs the kernel's stages of one mode and nothing else (for a profiler: perf record).
 #include "rgmcBenchmark.h"
 

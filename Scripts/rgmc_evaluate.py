@@ -517,19 +517,13 @@ def kernel_report(result, args):
               "| volume | threads | FE (s) | FE scan (s) | FE own ns/triangle | seeded filter "
               "ns/triangle | filter / FE own | seeded kernel ns/triangle: growth, extraction = total "
               "| kernel / FE own |", "|---|---|---|---|---|---|---|---|---|"]
-    for r in runs:
+    for r in runs + result.get("dense", []):
         ns = r["seeded_ns_per_triangle"]
+        kernel = ns.get("kernel", ns.get("seed", 0.0) + ns["growth"] + ns["extraction"])
+        own = r["flying_edges_own_ns_per_triangle"]
         lines.append("| %s | %d | %.3f | %.3f | %.0f | %.0f | %.2f | %.0f, %.0f = %.0f | %.2f |" % (
-            r["volume"], r["threads"], r["flying_edges"], r["flying_edges_scan"],
-            r["flying_edges_own_ns_per_triangle"], ns["total"], r["seeded_vs_flying_edges_own"],
-            ns["growth"], ns["extraction"], ns["seed"] + ns["growth"] + ns["extraction"],
-            (ns["seed"] + ns["growth"] + ns["extraction"]) / r["flying_edges_own_ns_per_triangle"]))
-    for r in result.get("dense", []):
-        ns = r["seeded_ns_per_triangle"]
-        lines.append("| %s | %d | %.3f | %.3f | %.0f | %.0f | %.2f | %.0f, %.0f = %.0f | %.2f |" % (
-            r["volume"], r["threads"], r["flying_edges"], r["flying_edges_scan"],
-            r["flying_edges_own_ns_per_triangle"], ns["total"], r["seeded_vs_flying_edges_own"],
-            ns["growth"], ns["extraction"], ns["kernel"], r["seeded_kernel_vs_flying_edges_own"]))
+            r["volume"], r["threads"], r["flying_edges"], r["flying_edges_scan"], own, ns["total"],
+            r["seeded_vs_flying_edges_own"], ns["growth"], ns["extraction"], kernel, kernel / own))
     if result.get("dense"):
         lines += ["", "Triangles: " + "; ".join(
             "%s: FE %d, seeded %d" % (r["volume"], r["flying_edges_triangles"], r["seeded_triangles"])
