@@ -394,26 +394,27 @@ private:
             {
               return;
             }
-            if (own.Owns(i, j, k) && this->TileOf(i, j, k) == tile)
+            const bool owned = own.Owns(i, j, k);
+            if (owned && this->TileOf(i, j, k) == tile)
             {
               this->Visit(w, i, j, k, v.Key, edge, n.Component, nullptr);
             }
             else
             {
-              this->StepOutOfTile(w, i, j, k, v.Key, edge, n.Component, keepInTile);
+              this->StepOutOfTile(w, i, j, k, v.Key, edge, n.Component, owned, keepInTile);
             }
           });
       });
   }
 
   /// A step of component `comp` to cube (i, j, k) for vertex `key` (on the cube's edge `edge`)
-  /// that leaves the expanding node's tile: to another tile of this rank, a crossing (unless
-  /// `keepInTile`); to another rank's cube, a departure (when CrossRanks); outside the volume,
-  /// nothing.
-  RGMC_INLINE void StepOutOfTile(
-    TileWork& w, int i, int j, int k, std::int64_t key, int edge, int comp, bool keepInTile)
+  /// that leaves the expanding node's tile: to another tile of this rank (`owned`), a crossing
+  /// (unless `keepInTile`); to another rank's cube, a departure (when CrossRanks); outside the
+  /// volume, nothing.
+  RGMC_INLINE void StepOutOfTile(TileWork& w, int i, int j, int k, std::int64_t key, int edge,
+    int comp, bool owned, bool keepInTile)
   {
-    if (!this->Volume.Owned.Owns(i, j, k))
+    if (!owned)
     {
       // Owned cubes lie inside the volume; one of another rank is a departure.
       if (this->CrossRanks && this->Volume.GridOf.HasCell(i, j, k))
@@ -469,7 +470,8 @@ private:
         }
         else
         {
-          this->StepOutOfTile(w, i, j, k, key(), nb.Edge, n.Component, keepInTile);
+          this->StepOutOfTile(
+            w, i, j, k, key(), nb.Edge, n.Component, this->Volume.Owned.Owns(i, j, k), keepInTile);
         }
       }
     }
