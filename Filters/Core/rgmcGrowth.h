@@ -27,6 +27,7 @@
 #include "rgmcKeyMap.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -51,6 +52,64 @@ struct Arrival
   std::int64_t Key;
   int Label;
 };
+
+/// Growth's tiles: 32 cubes along each axis; a cube's found-bit in its tile is
+/// i + 32 j + 1024 k (tile-local), so a step to a neighbour in the tile is a fixed offset.
+constexpr int GrowthTileCubes = 32;
+
+/// A step of growth from a cube to one of the 3 other cubes around one of its edges
+/// (EdgeNeighbourTable's), with what growth needs to take it inside a tile without arithmetic:
+/// the neighbour's found-bit offset, and the room the step needs (bit 2a: one cube below along
+/// axis a; bit 2a + 1: one cube above).
+struct TileStep
+{
+  std::int16_t BitOffset;
+  std::int8_t Offset[3];
+  std::int8_t Edge; // the neighbour's edge that carries the vertex
+  std::uint8_t Needs;
+};
+
+/// EdgeNeighbourTable as tile steps, in the same order.
+constexpr std::array<std::array<TileStep, 3>, 12> TileSteps()
+{
+  std::array<std::array<TileStep, 3>, 12> table{};
+  for (int e = 0; e < 12; ++e)
+  {
+    for (int n = 0; n < 3; ++n)
+    {
+      const EdgeNeighbour& nb = EdgeNeighbourTable[e][n];
+      TileStep& step = table[e][n];
+      int needs = 0;
+      for (int a = 0; a < 3; ++a)
+      {
+        step.Offset[a] = nb.Offset[a];
+        needs |= (nb.Offset[a] < 0 ? 1 : 0) << (2 * a);
+        needs |= (nb.Offset[a] > 0 ? 1 : 0) << (2 * a + 1);
+      }
+      step.BitOffset = static_cast<std::int16_t>(
+        nb.Offset[0] + GrowthTileCubes * (nb.Offset[1] + GrowthTileCubes * nb.Offset[2]));
+      step.Edge = nb.Edge;
+      step.Needs = static_cast<std::uint8_t>(needs);
+    }
+  }
+  return table;
+}
+constexpr std::array<std::array<TileStep, 3>, 12> TileStepTable = TileSteps();
+
+/// The room around cube c inside its tile of the box `owned` (tiles counted from owned.Lo), as
+/// TileStep::Needs bits: a step whose Needs are all in the room lands in the same tile and in
+/// the box.
+RGMC_INLINE unsigned TileRoom(const int c[3], const CellBox& owned)
+{
+  unsigned room = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    const int x = (c[a] - owned.Lo[a]) & (GrowthTileCubes - 1);
+    room |= unsigned(x > 0) << (2 * a);
+    room |= unsigned(x < GrowthTileCubes - 1 && c[a] < owned.Hi[a]) << (2 * a + 1);
+  }
+  return room;
+}
 
 template <typename Values>
 class SurfaceGrowth
@@ -258,7 +317,7 @@ private:
     std::int64_t Examined = 0; // cubes whose samples Visit read
   };
 
-  static constexpr int TileCubes = 32;    // cubes along each axis of a tile
+  static constexpr int TileCubes = GrowthTileCubes;
   static constexpr int PrefetchAhead = 8; // queued nodes between a prefetch and the expansion
   static constexpr int TileWords = 512;   // 64-bit words of found-bits in a tile (32^3 bits)
 
@@ -339,6 +398,13 @@ private:
     {
       return;
     }
+    this->VisitUnfound(w, i, j, k, bit, key, edge, comp, seen);
+  }
+
+  /// Visit, for a cube whose found-bit `bit` is known and was checked (unless `seen`).
+  RGMC_NOINLINE void VisitUnfound(TileWork& w, int i, int j, int k, std::int64_t bit,
+    std::int64_t key, int edge, int comp, bool* seen)
+  {
     CubeSamples st;
     ++w.Examined;
     if (!this->Volume.Evaluate(i, j, k, st))
@@ -430,48 +496,40 @@ private:
 
   /// Expand for a node of a cube without a degenerate sample, on a rank whose owned cubes are
   /// its box (the common case): the same steps in the same order, taken from the node's sheet
-  /// edges and EdgeNeighbourTable. A neighbour in the node's tile is found at a fixed offset of
-  /// the node's found-bit, the vertex's key made only when the neighbour is visited; one outside
-  /// it (another tile's, or no owned cube) is handled as Expand does.
+  /// edges and TileStepTable. A neighbour in the node's tile (the step's needs within the
+  /// node's room) is found at a fixed offset of the node's found-bit, the vertex's key made only
+  /// when the neighbour is visited; one outside it (another tile's, or no owned cube) is handled
+  /// as Expand does.
   RGMC_INLINE void ExpandByTable(std::int64_t tile, const SurfaceNode& n, bool keepInTile)
   {
     TileWork& w = this->Work[tile];
-    const CellBox& b = this->Volume.Owned.Mine();
     const std::int64_t bit = this->CubeBit(n.I, n.J, n.K);
-    // The steps along each axis that stay in the tile (and the owned box): from lo to hi.
     const int c[3] = { n.I, n.J, n.K };
-    int lo[3], hi[3];
-    bool inside = true;
-    for (int a = 0; a < 3; ++a)
-    {
-      const int x = (c[a] - b.Lo[a]) & (TileCubes - 1);
-      lo[a] = x > 0 ? -1 : 0;
-      hi[a] = x < TileCubes - 1 && c[a] < b.Hi[a] ? 1 : 0;
-      inside = inside && lo[a] < 0 && hi[a] > 0;
-    }
+    const unsigned room = TileRoom(c, this->Volume.Owned.Mine());
     for (unsigned edges = this->Volume.Table[n.Case].SheetEdges[n.Node]; edges; edges &= edges - 1)
     {
       const int e = __builtin_ctz(edges);
-      const int* p = CornerOffset[EdgeCorners[e][0]];
       auto key = [&]()
-      { return this->Volume.GridOf.EdgeKey(n.I + p[0], n.J + p[1], n.K + p[2], CubeEdgeAxis[e]); };
-      for (const EdgeNeighbour& nb : EdgeNeighbourTable[e])
       {
-        const std::int8_t* o = nb.Offset;
-        const int i = n.I + o[0], j = n.J + o[1], k = n.K + o[2];
-        if (inside ||
-          (o[0] >= lo[0] && o[0] <= hi[0] && o[1] >= lo[1] && o[1] <= hi[1] && o[2] >= lo[2] &&
-            o[2] <= hi[2]))
+        const int* p = CornerOffset[EdgeCorners[e][0]];
+        return this->Volume.GridOf.EdgeKey(n.I + p[0], n.J + p[1], n.K + p[2], CubeEdgeAxis[e]);
+      };
+      for (const TileStep& step : TileStepTable[e])
+      {
+        if ((step.Needs & ~room) == 0)
         {
-          if (!this->AllFound(bit + o[0] + 32 * o[1] + 1024 * o[2]))
+          const std::int64_t to = bit + step.BitOffset;
+          if (!this->AllFound(to))
           {
-            this->Visit(w, i, j, k, key(), nb.Edge, n.Component, nullptr);
+            this->VisitUnfound(w, n.I + step.Offset[0], n.J + step.Offset[1], n.K + step.Offset[2],
+              to, key(), step.Edge, n.Component, nullptr);
           }
         }
         else
         {
-          this->StepOutOfTile(
-            w, i, j, k, key(), nb.Edge, n.Component, this->Volume.Owned.Owns(i, j, k), keepInTile);
+          const int i = n.I + step.Offset[0], j = n.J + step.Offset[1], k = n.K + step.Offset[2];
+          this->StepOutOfTile(w, i, j, k, key(), step.Edge, n.Component,
+            this->Volume.Owned.Owns(i, j, k), keepInTile);
         }
       }
     }

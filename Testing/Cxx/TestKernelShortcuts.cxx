@@ -4,6 +4,10 @@
 //     and fractional isovalues, isovalues beyond the samples' type and NaN;
 //   - EdgeNeighbourTable (growth's fixed steps to the cubes around an edge) against
 //     ForCubesAround, in the same order, and the neighbour's edge being the same edge;
+//   - TileStepTable (the same steps with their found-bit offsets and needed room) against the
+//     steps themselves: for every cube of a box of several partial tiles, every step's neighbour
+//     is taken inside the tile exactly when it lies in the cube's tile and in the box, at the
+//     table's offset of the tile-local found-bit;
 //   - the full scan (GrowAll) finding exactly the cubes that have surface nodes, counted by
 //     brute force over every cube (Evaluate + Describe), on volumes cut into partial tiles, with
 //     samples equal to the isovalue, and on a piece whose cubes overlap a lower rank's;
@@ -211,6 +215,64 @@ void CheckEdgeNeighbours()
   }
 }
 
+/// TileStepTable and TileRoom against the tiles and the box they stand for.
+void CheckTileSteps()
+{
+  rgmc::CellBox box;
+  const int lo[3] = { 3, -2, 5 }, size[3] = { 70, 40, 33 }; // partial tiles on every axis
+  for (int a = 0; a < 3; ++a)
+  {
+    box.Lo[a] = lo[a];
+    box.Hi[a] = lo[a] + size[a] - 1;
+  }
+  const int t = rgmc::GrowthTileCubes;
+  auto tileOf = [&](const int c[3]) {
+    return std::make_tuple((c[0] - box.Lo[0]) / t, (c[1] - box.Lo[1]) / t, (c[2] - box.Lo[2]) / t);
+  };
+  auto localBit = [&](const int c[3])
+  {
+    return ((c[0] - box.Lo[0]) % t) + t * (((c[1] - box.Lo[1]) % t) + t * ((c[2] - box.Lo[2]) % t));
+  };
+  std::int64_t inside = 0, outside = 0;
+  int c[3];
+  for (c[2] = box.Lo[2]; c[2] <= box.Hi[2]; ++c[2])
+  {
+    for (c[1] = box.Lo[1]; c[1] <= box.Hi[1]; ++c[1])
+    {
+      for (c[0] = box.Lo[0]; c[0] <= box.Hi[0]; ++c[0])
+      {
+        const unsigned room = rgmc::TileRoom(c, box);
+        for (int e = 0; e < 12; ++e)
+        {
+          for (int n = 0; n < 3; ++n)
+          {
+            const rgmc::TileStep& step = rgmc::TileStepTable[e][n];
+            const rgmc::EdgeNeighbour& nb = rgmc::EdgeNeighbourTable[e][n];
+            const int to[3] = { c[0] + nb.Offset[0], c[1] + nb.Offset[1], c[2] + nb.Offset[2] };
+            const bool expected = box.Contains(to[0], to[1], to[2]) && tileOf(to) == tileOf(c);
+            const bool taken = (step.Needs & ~room) == 0;
+            RGMC_CHECK(taken == expected,
+              "cube " << c[0] << " " << c[1] << " " << c[2] << ", edge " << e << ", step " << n
+                      << ": taken inside the tile " << taken << ", expected " << expected);
+            RGMC_CHECK(step.Edge == nb.Edge && step.Offset[0] == nb.Offset[0] &&
+                step.Offset[1] == nb.Offset[1] && step.Offset[2] == nb.Offset[2],
+              "edge " << e << ", step " << n << ": not EdgeNeighbourTable's step");
+            if (expected)
+            {
+              RGMC_CHECK(localBit(c) + step.BitOffset == localBit(to),
+                "cube " << c[0] << " " << c[1] << " " << c[2] << ", edge " << e << ", step " << n
+                        << ": found-bit offset " << step.BitOffset << ", expected "
+                        << localBit(to) - localBit(c));
+            }
+            (expected ? inside : outside) += 1;
+          }
+        }
+      }
+    }
+  }
+  RGMC_CHECK(inside > 0 && outside > 0, "steps inside " << inside << ", outside " << outside);
+}
+
 /// The full scan on `owner` of `boxes`, against a brute-force count of the owned cubes that
 /// have nodes.
 void CheckScan(const char* what, const int n[3], const std::vector<rgmc::CellBox>& boxes, int owner)
@@ -295,6 +357,7 @@ int main()
   CheckClassifyRow<int>("int32 samples, isovalue -0.5", false, -0.5);
   CheckClassifyRow<long long>("int64 samples (compared in double)", false, 2.5);
   CheckEdgeNeighbours();
+  CheckTileSteps();
   // Partial tiles (70 = 2 x 32 + 6 points), more than one tile along each axis.
   const int n[3] = { 70, 45, 38 };
   const rgmc::CellBox all = Piece(n).GridOf.WholeCells();
