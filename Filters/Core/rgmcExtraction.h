@@ -188,6 +188,11 @@ public:
       found.Clear();
     }
     this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
+    for (int e = 0; e < 12; ++e)
+    {
+      const int* o = CornerOffset[EdgeCorners[e][0]];
+      this->EdgeSlotOffset[e] = static_cast<std::int32_t>(o[0] + this->LayerNx * o[1]);
+    }
     this->PlaneSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
 
     const int numChunks = (numSlabs + ChunkSlabs - 1) / ChunkSlabs;
@@ -270,6 +275,7 @@ private:
     EdgeLayer Layers[5];
     EdgeLayer* SlabLayers[2][2] = { { nullptr, nullptr }, { nullptr, nullptr } };
     EdgeLayer* VerticalLayer = nullptr;
+    EdgeLayer* EdgeLayerOf[12] = {}; // per cube edge: the layer of its slot in the current slab
     int SlabK = 0;
     std::unique_ptr<KeyMap> PointVertices;
   };
@@ -337,6 +343,12 @@ private:
       work.SlabLayers[1][0] = top[0];
       work.SlabLayers[1][1] = top[1];
       work.VerticalLayer = vertical;
+      for (int e = 0; e < 12; ++e)
+      {
+        const int axis = CubeEdgeAxis[e];
+        work.EdgeLayerOf[e] =
+          axis == 2 ? vertical : work.SlabLayers[CornerOffset[EdgeCorners[e][0]][2]][axis];
+      }
       work.SlabK = box.Lo[2] + s;
       for (std::int64_t n = start[s]; n < start[s + 1]; ++n)
       {
@@ -448,10 +460,8 @@ private:
   RGMC_INLINE std::int32_t EdgeVertex(
     ChunkWork& work, const SurfaceNode& n, int e, std::int32_t at, const CubeSurface& surface)
   {
-    const int* o = CornerOffset[EdgeCorners[e][0]];
-    const int axis = CubeEdgeAxis[e];
-    EdgeLayer* layer = axis == 2 ? work.VerticalLayer : work.SlabLayers[o[2]][axis];
-    const std::int32_t index = at + o[0] + static_cast<std::int32_t>(this->LayerNx) * o[1];
+    EdgeLayer* layer = work.EdgeLayerOf[e];
+    const std::int32_t index = at + this->EdgeSlotOffset[e];
     std::int32_t& slot = layer->Ids[index];
     if (slot > 0)
     {
@@ -753,6 +763,7 @@ private:
   SampledVolume<Values>& Volume;
   ComponentSet& Components;
   std::int64_t LayerNx = 0;
+  std::int32_t EdgeSlotOffset[12] = {}; // per cube edge: its slot's offset from the cube's
   std::size_t PlaneSize = 0;
   CellBox NodeBox; // the cubes of the nodes
   std::int64_t JoinCount = 0;
