@@ -763,7 +763,7 @@ private:
   SampledVolume<Values>& Volume;
   ComponentSet& Components;
   std::int64_t LayerNx = 0;
-  std::int32_t EdgeSlotOffset[12] = {}; // per cube edge: its slot's offset from the cube's
+  std::int32_t EdgeSlotOffset[12] = {}; // per cube edge: its slot, from the cube's in a layer
   std::size_t PlaneSize = 0;
   CellBox NodeBox; // the cubes of the nodes
   std::int64_t JoinCount = 0;
