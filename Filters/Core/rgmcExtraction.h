@@ -273,10 +273,7 @@ private:
   {
     Chunk* Out = nullptr;
     EdgeLayer Layers[5];
-    EdgeLayer* SlabLayers[2][2] = { { nullptr, nullptr }, { nullptr, nullptr } };
-    EdgeLayer* VerticalLayer = nullptr;
     EdgeLayer* EdgeLayerOf[12] = {}; // per cube edge: the layer of its slot in the current slab
-    int SlabK = 0;
     std::unique_ptr<KeyMap> PointVertices;
   };
 
@@ -338,18 +335,12 @@ private:
     CubeSurface surface;
     for (int s = first; s < last && !this->Volume.Stopped(); ++s)
     {
-      work.SlabLayers[0][0] = bottom[0];
-      work.SlabLayers[0][1] = bottom[1];
-      work.SlabLayers[1][0] = top[0];
-      work.SlabLayers[1][1] = top[1];
-      work.VerticalLayer = vertical;
       for (int e = 0; e < 12; ++e)
       {
         const int axis = CubeEdgeAxis[e];
-        work.EdgeLayerOf[e] =
-          axis == 2 ? vertical : work.SlabLayers[CornerOffset[EdgeCorners[e][0]][2]][axis];
+        EdgeLayer* const* plane = CornerOffset[EdgeCorners[e][0]][2] == 0 ? bottom : top;
+        work.EdgeLayerOf[e] = axis == 2 ? vertical : plane[axis];
       }
-      work.SlabK = box.Lo[2] + s;
       for (std::int64_t n = start[s]; n < start[s + 1]; ++n)
       {
         if (n + PrefetchAhead < start[s + 1])
@@ -449,8 +440,7 @@ private:
     const CellBox& box = this->NodeBox;
     const std::int32_t index = static_cast<std::int32_t>(
       (v.Point[0] - box.Lo[0]) + this->LayerNx * (v.Point[1] - box.Lo[1]));
-    EdgeLayer* layer =
-      v.Axis == 2 ? work.VerticalLayer : work.SlabLayers[v.Point[2] - work.SlabK][v.Axis];
+    EdgeLayer* layer = work.EdgeLayerOf[v.Edge]; // the cube's edge that carries the vertex
     return this->UseVertex(work, layer->Ids[index], v, n.Component, layer, index);
   }
 
