@@ -3,6 +3,8 @@
 #ifndef rgmcBuffer_h
 #define rgmcBuffer_h
 
+#include "rgmcInline.h"
+
 #include <algorithm>
 #include <cstdlib>
 #if defined(__unix__) || defined(__APPLE__)
@@ -181,21 +183,24 @@ public:
     }
   }
 
-  void push_back(const T& value)
+  // push_back and append are in extraction's loop over triangles: always inlined (the
+  // plugin's library, which holds the kernel for every sample type, called them otherwise),
+  // their growth out of line.
+  RGMC_INLINE void push_back(const T& value)
   {
     if (this->Size == this->Capacity)
     {
-      this->reserve(this->Capacity ? 2 * this->Capacity : 64);
+      this->Grow(this->Capacity ? 2 * this->Capacity : 64);
     }
     this->Data[this->Size++] = value;
   }
 
   /// Appends n values.
-  void append(const T* values, std::size_t n)
+  RGMC_INLINE void append(const T* values, std::size_t n)
   {
     if (this->Size + n > this->Capacity)
     {
-      this->reserve(std::max(this->Size + n, 2 * this->Capacity));
+      this->Grow(std::max(this->Size + n, 2 * this->Capacity));
     }
     std::memcpy(this->Data + this->Size, values, n * sizeof(T));
     this->Size += n;
@@ -237,6 +242,8 @@ public:
   }
 
 private:
+  RGMC_NOINLINE void Grow(std::size_t capacity) { this->reserve(capacity); }
+
   T* Data = nullptr;
   std::size_t Size = 0;
   std::size_t Capacity = 0;
