@@ -11,9 +11,11 @@
 // tile to that tile as a crossing for the next round - the protocol ranks use between pieces,
 // inside one rank. A tile's work in a round depends only on its crossings, taken in the order
 // of the tiles that sent them, so the nodes found and their order are the same for any number
-// of threads. The full scan (All and Largest modes) searches each tile on its own, crossings
-// dropped: a component that spans tiles gets one label per tile, and extraction joins them
-// through their shared vertices, as it joins components across ranks.
+// of threads. A tile posts its crossings at the end of its round, grouped by the neighbour they
+// go to, and each neighbour reads its group in the next round: the exchange between rounds is
+// done by the tiles themselves, on threads. The full scan (All and Largest modes) searches each
+// tile on its own, crossings dropped: a component that spans tiles gets one label per tile, and
+// extraction joins them through their shared vertices, as it joins components across ranks.
 //
 // Ranks. With CrossRanks set, a step into a cube another rank owns is kept as a departure (the
 // vertex and the component that reached it); the VTK layer sends departures to the cubes'
@@ -173,6 +175,27 @@ public:
     return total;
   }
 
+  /// How many crossings tiles sent each other, and how many the tiles they went to read (the
+  /// same, once no growth is pending: each crossing is read once).
+  std::int64_t CrossingsPosted() const
+  {
+    std::int64_t total = 0;
+    for (const TileWork& w : this->Work)
+    {
+      total += w.Posted;
+    }
+    return total;
+  }
+  std::int64_t CrossingsRead() const
+  {
+    std::int64_t total = 0;
+    for (const TileWork& w : this->Work)
+    {
+      total += w.Read;
+    }
+    return total;
+  }
+
   /// Grows on from vertices that other ranks' growth reached: every arrival label becomes a new
   /// seeded component (reachable from a seed), grown from the nodes of this rank's cubes that
   /// use the arrival's vertex and were not found yet. Arrivals are taken in the order given.
@@ -303,18 +326,31 @@ private:
     std::int8_t Edge;
   };
 
-  /// A tile's search state: nodes found in the current round (the queue), crossings received
-  /// for the next round and sent to other tiles in this one, and which nodes of its cubes of
-  /// several nodes were found. Each on cache lines of its own: threads grow neighbouring tiles
-  /// at once.
+  /// The crossings a tile sent in one round, grouped by the tile they go to: those for the
+  /// neighbour in direction d (d = (di + 1) + 3 (dj + 1) + 9 (dk + 1), tile offsets di, dj, dk)
+  /// are Items[Start[d], Start[d + 1]), in the order sent.
+  struct Mail
+  {
+    Buffer<Crossing> Items;
+    std::array<std::int32_t, 28> Start;
+    std::int64_t Round = -1; // the round that sent them
+  };
+
+  /// A tile's search state: nodes found in the current round (the queue), crossings sent to
+  /// other tiles in this round (the outbox, posted as mail at the round's end; the mail of the
+  /// round before stays for its readers meanwhile), and which nodes of its cubes of several
+  /// nodes were found. Each on cache lines of its own: threads grow neighbouring tiles at once.
   struct alignas(64) TileWork
   {
     std::vector<SurfaceNode> Queue;
-    std::vector<Crossing> Inbox;
     std::vector<Crossing> Outbox;
     std::vector<Departure> Departures;
     std::unique_ptr<KeyMap> FoundNodesOfCube;
-    std::int64_t Examined = 0; // cubes whose samples Visit read
+    std::unique_ptr<Mail> Sent[2]; // by the parity of the round that sent it
+    std::int64_t Examined = 0;     // cubes whose samples Visit read
+    std::int64_t MailRound = -1;   // the last round that sent this tile crossings
+    std::int64_t Posted = 0;       // crossings this tile sent
+    std::int64_t Read = 0;         // crossings this tile was sent and read
   };
 
   static constexpr int TileCubes = GrowthTileCubes;
@@ -621,48 +657,134 @@ private:
         this->Pending.swap(active); // the rest in a later call
         return;
       }
+      const std::int64_t round = ++this->Round;
       this->Volume.Parallel(static_cast<std::int64_t>(active.size()),
         [&](std::int64_t n)
         {
           const std::int64_t tile = active[n];
-          TileWork& w = this->Work[tile];
-          for (const Crossing& c : w.Inbox)
-          {
-            this->Visit(w, c.I, c.J, c.K, c.Key, c.Edge, c.Component, nullptr);
-          }
-          w.Inbox = std::vector<Crossing>();
+          this->ReadMail(tile, round - 1);
           this->ExpandQueue(tile, 0, false);
+          this->PostMail(tile, round);
         });
       if (this->Volume.Stopped())
       {
         return;
       }
-      // The round's nodes, tile by tile; the crossings, in the order of their senders.
+      // The round's nodes, tile by tile; the tiles its mail goes to.
       std::vector<std::int64_t> next;
       for (const std::int64_t tile : active)
       {
         TileWork& w = this->Work[tile];
         this->NodesExpanded += static_cast<std::int64_t>(w.Queue.size());
         this->Found.Append(w.Queue); // the queue itself, not a copy
-        for (const Crossing& c : w.Outbox)
-        {
-          const std::int64_t to = this->TileOf(c.I, c.J, c.K);
-          if (this->Work[to].Inbox.empty())
-          {
-            next.push_back(to);
-          }
-          this->Work[to].Inbox.push_back(c);
-        }
-        w.Outbox = std::vector<Crossing>();
         this->Departures.insert(this->Departures.end(), w.Departures.begin(), w.Departures.end());
         w.Departures = std::vector<Departure>();
+        const Mail* mail = w.Sent[round & 1].get();
+        if (!mail || mail->Round != round)
+        {
+          continue;
+        }
+        for (int d = 0; d < 27; ++d)
+        {
+          const std::int64_t to = tile + this->TileOffset(d);
+          if (mail->Start[d + 1] > mail->Start[d] && this->Work[to].MailRound != round)
+          {
+            this->Work[to].MailRound = round;
+            next.push_back(to);
+          }
+        }
       }
+      // The mail of the round before was read in this one.
+      for (const std::int64_t tile : this->LastSenders)
+      {
+        this->Work[tile].Sent[(round - 1) & 1].reset();
+      }
+      this->LastSenders = active;
       std::sort(next.begin(), next.end());
       active.swap(next);
       // The surface's size is unknown while it grows: an estimate that approaches 1.
       const double done = static_cast<double>(this->NodesExpanded);
       this->Volume.Report(0.5 * done / (done + (1 << 20)));
     }
+  }
+
+  /// The offset of the neighbouring tile in direction d (see Mail).
+  std::int64_t TileOffset(int d) const
+  {
+    return (d % 3 - 1) + this->Tiles[0] * ((d / 3 % 3 - 1) + this->Tiles[1] * (d / 9 - 1));
+  }
+
+  /// Visits the crossings tile `tile` was sent in round `round`: from its neighbours in tile
+  /// order, each one's in the order sent.
+  void ReadMail(std::int64_t tile, std::int64_t round)
+  {
+    TileWork& w = this->Work[tile];
+    const std::int64_t t[3] = { tile % this->Tiles[0], (tile / this->Tiles[0]) % this->Tiles[1],
+      tile / (this->Tiles[0] * this->Tiles[1]) };
+    for (int d = 0; d < 27; ++d)
+    {
+      const int o[3] = { d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1 };
+      if (d == 13 || t[0] + o[0] < 0 || t[0] + o[0] >= this->Tiles[0] || t[1] + o[1] < 0 ||
+        t[1] + o[1] >= this->Tiles[1] || t[2] + o[2] < 0 || t[2] + o[2] >= this->Tiles[2])
+      {
+        continue;
+      }
+      const Mail* mail = this->Work[tile + this->TileOffset(d)].Sent[round & 1].get();
+      if (!mail || mail->Round != round)
+      {
+        continue;
+      }
+      const int back = 26 - d; // the direction from the sender to this tile
+      w.Read += mail->Start[back + 1] - mail->Start[back];
+      for (std::int32_t m = mail->Start[back]; m < mail->Start[back + 1]; ++m)
+      {
+        const Crossing& c = mail->Items[m];
+        this->Visit(w, c.I, c.J, c.K, c.Key, c.Edge, c.Component, nullptr);
+      }
+    }
+  }
+
+  /// Posts the crossings tile `tile` sent in round `round` as its mail, grouped by the tile
+  /// they go to (a stable counting sort).
+  void PostMail(std::int64_t tile, std::int64_t round)
+  {
+    TileWork& w = this->Work[tile];
+    if (w.Outbox.empty())
+    {
+      return;
+    }
+    const CellBox& b = this->Volume.Owned.Mine();
+    const std::int64_t t[3] = { tile % this->Tiles[0], (tile / this->Tiles[0]) % this->Tiles[1],
+      tile / (this->Tiles[0] * this->Tiles[1]) };
+    auto direction = [&](const Crossing& c)
+    {
+      return static_cast<int>((((c.I - b.Lo[0]) >> 5) - t[0] + 1) +
+        3 * (((c.J - b.Lo[1]) >> 5) - t[1] + 1) + 9 * (((c.K - b.Lo[2]) >> 5) - t[2] + 1));
+    };
+    w.Posted += static_cast<std::int64_t>(w.Outbox.size());
+    std::unique_ptr<Mail>& slot = w.Sent[round & 1];
+    if (!slot)
+    {
+      slot.reset(new Mail);
+    }
+    Mail& mail = *slot;
+    mail.Round = round;
+    std::array<std::int32_t, 28> next{};
+    for (const Crossing& c : w.Outbox)
+    {
+      ++next[direction(c) + 1];
+    }
+    for (int d = 0; d < 27; ++d)
+    {
+      next[d + 1] += next[d];
+    }
+    mail.Start = next;
+    mail.Items.resize_for_overwrite(w.Outbox.size());
+    for (const Crossing& c : w.Outbox)
+    {
+      mail.Items[next[direction(c)]++] = c;
+    }
+    w.Outbox = std::vector<Crossing>();
   }
 
   /// Grows from every vertex on the plane of grid points p[axis] = `plane` of this rank's box.
@@ -866,7 +988,9 @@ private:
   std::vector<TileWork> Work;          // per tile
   NodeList Found;
   std::vector<Departure> Departures;
-  std::vector<std::int64_t> Pending; // tiles with crossings left by the budget, sorted
+  std::vector<std::int64_t> Pending;     // tiles with crossings left by the budget, sorted
+  std::int64_t Round = 0;                // rounds of tiles searched so far
+  std::vector<std::int64_t> LastSenders; // the tiles searched in the last round
   std::int64_t Budget = std::numeric_limits<std::int64_t>::max();
   std::int64_t NodesExpanded = 0;
   std::int64_t ScannedCubes = 0; // cubes read by ScanRegion

@@ -92,6 +92,8 @@ public:
   std::vector<Port>& Ports() override { return this->Extraction.Ports; }
   ComponentSet& Components() override { return this->Found; }
   std::int64_t Joins() const { return this->Extraction.Joins(); }
+  std::int64_t CrossingsPosted() const { return this->Growth.CrossingsPosted(); }
+  std::int64_t CrossingsRead() const { return this->Growth.CrossingsRead(); }
 
   std::string Error() const override { return this->Volume.Error(); }
   bool Aborted() const override { return this->Volume.Aborted(); }

@@ -370,6 +370,9 @@ void RoundsBetweenOwners()
     std::set<Triangle> united;
     for (int r = 0; r < 4; ++r)
     {
+      RGMC_CHECK(kernels[r]->CrossingsRead() == kernels[r]->CrossingsPosted(),
+        "budget " << budget << ": owner " << r << "'s tiles read " << kernels[r]->CrossingsRead()
+                  << " crossings of the " << kernels[r]->CrossingsPosted() << " sent them");
       kernels[r]->Extract();
       for (const Triangle& t : KeyTriangles(kernels[r]->Mesh()))
       {
@@ -471,6 +474,104 @@ void TraversalIsComplete()
   RGMC_CHECK(joins == 0, "growth missed " << joins << " adjacencies that a later component met");
 }
 
+/// Seeded growth hands steps into other tiles to them as crossings, grouped by the neighbour
+/// they go to (across a face, an edge or a corner of the tile). On random fields over 3 x 3 x 3
+/// tiles, with samples equal to the isovalue (vertices on grid points), every crossing sent is
+/// read once, and seeds from every vertex grow each component whole: no two seeded components
+/// share a vertex (extraction would join them), the triangles are the full scan's, and the
+/// largest component reaches all 27 tiles.
+void CrossingsReachEveryNeighbourTile()
+{
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto next = [&state]()
+  {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return static_cast<double>(state % 1000000) / 1000000.0;
+  };
+  for (int trial = 0; trial < 3; ++trial)
+  {
+    const double pOne = 0.1 + 0.1 * trial, pTwo = 0.35 - 0.1 * trial;
+    Volume vol(70, 70, 70); // 69 cubes along each axis: 3 tiles of 32
+    for (float& v : vol.Values)
+    {
+      const double r = next();
+      v = r < pTwo ? 2.0f : (r < pTwo + pOne ? 1.0f : 0.0f);
+    }
+    const rgmc::Grid grid(vol.Extent, vol.Extent);
+    const rgmc::Ownership own = OwnAll(grid);
+    rgmc::SurfaceOptions params;
+    params.Isovalue = 1.0;
+    rgmc::SurfaceKernel<std::vector<float>> seeded(Table(), grid, own, vol.Values, params);
+    int components = 0;
+    for (int k = 0; k < 70; ++k)
+    {
+      for (int j = 0; j < 70; ++j)
+      {
+        for (int i = 0; i < 70; ++i)
+        {
+          const float s = vol.At(i, j, k);
+          std::vector<std::int64_t> keys;
+          if (s == 1.0f)
+          {
+            keys.push_back(grid.PointKey(i, j, k));
+          }
+          const int p[3] = { i, j, k };
+          for (int a = 0; a < 3; ++a)
+          {
+            int q[3] = { i, j, k };
+            if (++q[a] < 70)
+            {
+              const float t = vol.At(q[0], q[1], q[2]);
+              if ((s >= 1.0f) != (t >= 1.0f) && s != 1.0f && t != 1.0f)
+              {
+                keys.push_back(grid.EdgeKey(p[0], p[1], p[2], a));
+              }
+            }
+          }
+          for (const std::int64_t key : keys)
+          {
+            components += seeded.GrowFromKey(key) >= 0;
+          }
+        }
+      }
+    }
+    RGMC_CHECK(seeded.CrossingsPosted() > 0 && seeded.CrossingsRead() == seeded.CrossingsPosted(),
+      "trial " << trial << ": tiles read " << seeded.CrossingsRead() << " crossings of the "
+               << seeded.CrossingsPosted() << " sent them");
+    seeded.Extract();
+    rgmc::SurfaceKernel<std::vector<float>> full(Table(), grid, own, vol.Values, params);
+    full.GrowAll();
+    full.Extract();
+    RGMC_CHECK(seeded.Joins() == 0,
+      "trial " << trial << ": " << seeded.Joins() << " seeded components met another");
+    RGMC_CHECK(KeyTriangles(seeded.Mesh()) == KeyTriangles(full.Mesh()),
+      "trial " << trial << ": seeds from every vertex do not give the full scan's triangles");
+    // The tiles each component's vertices lie in (a grid point on a tile's upper face counts
+    // for the tile above it).
+    const rgmc::LocalMesh& mesh = seeded.Mesh();
+    std::map<int, std::set<int>> tiles;
+    for (std::int64_t v = 0; v < mesh.NumberOfPoints(); ++v)
+    {
+      int p[3], axis;
+      grid.Decode(mesh.Keys[v], p, axis);
+      tiles[mesh.VertexComponent[v]].insert(
+        std::min(p[0] / 32, 2) + 3 * (std::min(p[1] / 32, 2) + 3 * std::min(p[2] / 32, 2)));
+    }
+    std::size_t most = 0;
+    for (const auto& t : tiles)
+    {
+      most = std::max(most, t.second.size());
+    }
+    RGMC_CHECK(most == 27,
+      "trial " << trial << ": the largest component reaches " << most << " tiles of 27");
+    RGMC_CHECK(static_cast<int>(tiles.size()) <= components,
+      "trial " << trial << ": " << tiles.size() << " components in the mesh, " << components
+               << " seeded");
+  }
+}
+
 } // namespace
 
 int main()
@@ -482,5 +583,6 @@ int main()
   RoundsBetweenOwners();
   CostFollowsSurface();
   TraversalIsComplete();
+  CrossingsReachEveryNeighbourTile();
   return rgmc_test::Result("TestGrowth");
 }
