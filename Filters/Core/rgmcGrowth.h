@@ -708,6 +708,14 @@ private:
     }
   }
 
+  /// The position of tile `tile` among the tiles, along each axis.
+  void TileCoordinates(std::int64_t tile, std::int64_t t[3]) const
+  {
+    t[0] = tile % this->Tiles[0];
+    t[1] = (tile / this->Tiles[0]) % this->Tiles[1];
+    t[2] = tile / (this->Tiles[0] * this->Tiles[1]);
+  }
+
   /// The offset of the neighbouring tile in direction d (see Mail).
   std::int64_t TileOffset(int d) const
   {
@@ -719,8 +727,8 @@ private:
   void ReadMail(std::int64_t tile, std::int64_t round)
   {
     TileWork& w = this->Work[tile];
-    const std::int64_t t[3] = { tile % this->Tiles[0], (tile / this->Tiles[0]) % this->Tiles[1],
-      tile / (this->Tiles[0] * this->Tiles[1]) };
+    std::int64_t t[3];
+    this->TileCoordinates(tile, t);
     for (int d = 0; d < 27; ++d)
     {
       const int o[3] = { d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1 };
@@ -754,8 +762,8 @@ private:
       return;
     }
     const CellBox& b = this->Volume.Owned.Mine();
-    const std::int64_t t[3] = { tile % this->Tiles[0], (tile / this->Tiles[0]) % this->Tiles[1],
-      tile / (this->Tiles[0] * this->Tiles[1]) };
+    std::int64_t t[3];
+    this->TileCoordinates(tile, t);
     auto direction = [&](const Crossing& c)
     {
       return static_cast<int>((((c.I - b.Lo[0]) >> 5) - t[0] + 1) +
@@ -829,8 +837,8 @@ private:
   CellBox TileBox(std::int64_t tile) const
   {
     const CellBox& b = this->Volume.Owned.Mine();
-    const std::int64_t t[3] = { tile % this->Tiles[0], (tile / this->Tiles[0]) % this->Tiles[1],
-      tile / (this->Tiles[0] * this->Tiles[1]) };
+    std::int64_t t[3];
+    this->TileCoordinates(tile, t);
     CellBox box;
     for (int a = 0; a < 3; ++a)
     {
