@@ -437,29 +437,41 @@ void CostFollowsSurface()
   RGMC_CHECK(reads[1] < 96LL * 96 * 96 / 20, "reads " << reads[1] << " look like a full scan");
 }
 
+/// Uniform numbers in [0, 1) from a xorshift generator (the same on every platform).
+struct Random
+{
+  std::uint64_t State;
+  double operator()()
+  {
+    this->State ^= this->State << 13;
+    this->State ^= this->State >> 7;
+    this->State ^= this->State << 17;
+    return static_cast<double>(this->State % 1000000) / 1000000.0;
+  }
+};
+
+/// Samples 2 with probability pTwo, 1 (the tests' isovalue) with probability pOne, else 0.
+void FillThreeLevels(Volume& vol, double pOne, double pTwo, Random& next)
+{
+  for (float& v : vol.Values)
+  {
+    const double r = next();
+    v = r < pTwo ? 2.0f : (r < pTwo + pOne ? 1.0f : 0.0f);
+  }
+}
+
 /// On one owner, growth follows every adjacency by itself: a component never meets a vertex
 /// that another component created. Checked on many small volumes whose samples often equal
 /// the isovalue (where vertices collapse and surfaces touch only at points).
 void TraversalIsComplete()
 {
-  std::uint64_t state = 88172645463325252ull;
-  auto next = [&state]()
-  {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    return static_cast<double>(state % 1000000) / 1000000.0;
-  };
+  Random next{ 88172645463325252ull };
   std::int64_t joins = 0, triangles = 0;
   for (int trial = 0; trial < 400; ++trial)
   {
     const double pOne = 0.1 + 0.3 * next(), pTwo = 0.05 + 0.3 * next();
     Volume vol(7, 6, 7);
-    for (float& v : vol.Values)
-    {
-      const double r = next();
-      v = r < pTwo ? 2.0f : (r < pTwo + pOne ? 1.0f : 0.0f);
-    }
+    FillThreeLevels(vol, pOne, pTwo, next);
     const rgmc::Grid grid(vol.Extent, vol.Extent);
     const rgmc::Ownership own = OwnAll(grid);
     rgmc::SurfaceOptions params;
@@ -482,23 +494,12 @@ void TraversalIsComplete()
 /// largest component reaches all 27 tiles.
 void CrossingsReachEveryNeighbourTile()
 {
-  std::uint64_t state = 0x9E3779B97F4A7C15ull;
-  auto next = [&state]()
-  {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    return static_cast<double>(state % 1000000) / 1000000.0;
-  };
+  Random next{ 0x9E3779B97F4A7C15ull };
   for (int trial = 0; trial < 3; ++trial)
   {
     const double pOne = 0.1 + 0.1 * trial, pTwo = 0.35 - 0.1 * trial;
     Volume vol(70, 70, 70); // 69 cubes along each axis: 3 tiles of 32
-    for (float& v : vol.Values)
-    {
-      const double r = next();
-      v = r < pTwo ? 2.0f : (r < pTwo + pOne ? 1.0f : 0.0f);
-    }
+    FillThreeLevels(vol, pOne, pTwo, next);
     const rgmc::Grid grid(vol.Extent, vol.Extent);
     const rgmc::Ownership own = OwnAll(grid);
     rgmc::SurfaceOptions params;
