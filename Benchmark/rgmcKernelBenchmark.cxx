@@ -17,8 +17,12 @@
 // Minimum of the repeats; JSON on stdout, a summary on stderr.
 //
 //   rgmcKernelBenchmark [--size 512] [--ct-size 384] [--dense-size 256] [--threads 1,2]
-//                       [--repeats 5] [--only seeded|all]
+//                       [--repeats 5] [--only seeded|all|floor]
 // --only runs the kernel's stages of one mode and nothing else (for a profiler: perf record).
+// --only floor sets the seeded kernel's growth and extraction, on one thread, against the least
+// that growth and extraction node by node can do on the same volume from the same seed vertex
+// (GrowthFloor, ExtractionFloor): what the kernel's own machinery (tiles in rounds, chunks,
+// keys, components, ports, degenerate cubes) costs beyond the work any such design must do.
 #include "rgmcBenchmark.h"
 
 #include "rgmcSurfaceKernel.h"
@@ -45,6 +49,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace
@@ -187,7 +192,8 @@ const rgmc::CaseTable& Table()
 struct Stages
 {
   double Seed = 1e300, Growth = 1e300, Extraction = 1e300;
-  long long Triangles = 0;
+  long long Triangles = 0, Vertices = 0;
+  std::int64_t SeedKey = -1; // the seed vertex (seeded), -1 when none was found
 };
 
 Stages KernelStages(const Volume& v, bool seeded, int repeats)
@@ -249,6 +255,8 @@ Stages KernelStages(const Volume& v, bool seeded, int repeats)
     best.Growth = std::min(best.Growth, t2 - t1);
     best.Extraction = std::min(best.Extraction, t3 - t2);
     best.Triangles = kernel.Mesh().NumberOfTriangles();
+    best.SeedKey = key;
+    best.Vertices = kernel.Mesh().NumberOfPoints();
   }
   return best;
 }
@@ -293,6 +301,369 @@ double FlyingEdgesScanSeconds(const Volume& v, int repeats, long long& triangles
 double Ns(double seconds, long long triangles)
 {
   return triangles > 0 ? 1e9 * seconds / static_cast<double>(triangles) : 0.0;
+}
+
+/// A node of the least growth: a cube and one of its case's sheets.
+struct FloorNode
+{
+  int I, J, K;
+  std::uint8_t Case, Sheet;
+};
+
+/// What the least growth node by node found, and how fast.
+struct Floor
+{
+  double Seconds = 1e300;    // with each cube's case made from its 8 samples
+  double CasesReady = 1e300; // with each cube's case looked up, made before the clock
+  long long Triangles = 0;
+  std::vector<FloorNode> Nodes; // in the order found
+};
+
+/// The least that growth node by node can do: a breadth-first search over the (cube, sheet)
+/// nodes of the seeded component with growth's steps (the 3 other cubes around each of a
+/// node's edges, EdgeNeighbourTable) and found-bits in 32^3 tiles, nothing else (no ranks,
+/// tiles' rounds, components, keys or degenerate cubes: a sample equal to the isovalue counts
+/// as above it, so the component can differ from the filter's where such samples join
+/// surfaces). Its seed: the nodes that have the seeded filter's seed vertex (`seedKey`, on
+/// an edge or a grid point). Int16 samples, one thread, memory paged in before the clock starts.
+/// Twice: each cube's case made from its samples when visited, and looked up in a table of every
+/// cube's case (tile by tile, as the bits) made beforehand, which is the least a node-by-node
+/// design can pay however it gets its cases.
+Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
+{
+  vtkImageData* image = v.Image;
+  int dims[3], extent[6], seedPoint[3], seedAxis;
+  image->GetDimensions(dims);
+  image->GetExtent(extent);
+  rgmc::Grid(extent, extent).Decode(seedKey, seedPoint, seedAxis);
+  for (int a = 0; a < 3; ++a)
+  {
+    seedPoint[a] -= extent[2 * a];
+  }
+  const short* samples =
+    vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars())->GetPointer(0);
+  const std::int64_t sy = dims[0], sz = std::int64_t(dims[0]) * dims[1];
+  const int above = static_cast<int>(std::ceil(v.Isovalue)); // samples >= it are inside
+  auto caseOf = [=](int i, int j, int k)
+  {
+    const short* s = samples + i + sy * j + sz * k;
+    return (s[0] >= above) | (s[1] >= above) << 1 | (s[sy + 1] >= above) << 2 |
+      (s[sy] >= above) << 3 | (s[sz] >= above) << 4 | (s[sz + 1] >= above) << 5 |
+      (s[sz + sy + 1] >= above) << 6 | (s[sz + sy] >= above) << 7;
+  };
+  const int nx = dims[0] - 1, ny = dims[1] - 1, nz = dims[2] - 1; // cubes along each axis
+  const std::int64_t tx = (nx + 31) / 32, ty = (ny + 31) / 32, tz = (nz + 31) / 32;
+  auto cubeOf = [=](int i, int j, int k) // a cube's place in tile order
+  {
+    return ((i >> 5) + tx * ((j >> 5) + ty * (k >> 5))) * 32768 + (i & 31) +
+      32 * ((j & 31) + 32 * (k & 31));
+  };
+  using Node = FloorNode;
+  const rgmc::CaseTable& table = Table();
+  Floor result;
+  std::vector<std::uint64_t> found(static_cast<std::size_t>(tx * ty * tz * 512), 0);
+  std::vector<Node> queue;
+  auto search = [&](auto caseAt)
+  {
+    queue.clear();
+    std::fill(found.begin(), found.end(), 0);
+    std::unordered_map<std::int64_t, unsigned> sheetsFound; // cubes of several sheets
+    auto record = [&](int i, int j, int k, int c, int sheet)
+    {
+      const std::int64_t bit = cubeOf(i, j, k);
+      std::uint64_t& word = found[bit >> 6];
+      if ((word >> (bit & 63)) & 1)
+      {
+        return;
+      }
+      if (table[c].NumSheets > 1)
+      {
+        unsigned& mask = sheetsFound[bit];
+        if ((mask >> sheet) & 1)
+        {
+          return;
+        }
+        mask |= 1u << sheet;
+        if (mask != (1u << table[c].NumSheets) - 1)
+        {
+          queue.push_back(Node{ i, j, k, std::uint8_t(c), std::uint8_t(sheet) });
+          return;
+        }
+      }
+      word |= std::uint64_t(1) << (bit & 63);
+      queue.push_back(Node{ i, j, k, std::uint8_t(c), std::uint8_t(sheet) });
+    };
+    rgmc::ForCubesAround(seedPoint, seedAxis,
+      [&](int i, int j, int k, int edge)
+      {
+        if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz)
+        {
+          return;
+        }
+        const int c = caseAt(i, j, k);
+        for (int sheet = 0; sheet < table[c].NumSheets; ++sheet)
+        {
+          if (edge < 0 || table[c].EdgeSheet[edge] == sheet)
+          {
+            record(i, j, k, c, sheet);
+          }
+        }
+      });
+    long long made = 0;
+    for (std::size_t head = 0; head < queue.size(); ++head)
+    {
+      const Node n = queue[head];
+      const rgmc::CaseEntry& entry = table[n.Case];
+      for (int t = 0; t < entry.NumTriangles; ++t)
+      {
+        made += entry.TriangleSheet[t] == n.Sheet;
+      }
+      for (unsigned edges = entry.SheetEdges[n.Sheet]; edges; edges &= edges - 1)
+      {
+        for (const rgmc::EdgeNeighbour& step : rgmc::EdgeNeighbourTable[__builtin_ctz(edges)])
+        {
+          const int i = n.I + step.Offset[0], j = n.J + step.Offset[1], k = n.K + step.Offset[2];
+          if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz)
+          {
+            continue;
+          }
+          const std::int64_t bit = cubeOf(i, j, k);
+          if ((found[bit >> 6] >> (bit & 63)) & 1)
+          {
+            continue;
+          }
+          const int c = caseAt(i, j, k);
+          record(i, j, k, c, table[c].EdgeSheet[step.Edge]);
+        }
+      }
+    }
+    result.Triangles = made;
+  };
+  auto fastest = [&](auto caseAt)
+  {
+    double best = 1e300;
+    for (int r = 0; r <= repeats; ++r) // the first run only sizes the queue
+    {
+      const double t0 = Now();
+      search(caseAt);
+      if (r > 0)
+      {
+        best = std::min(best, Now() - t0);
+      }
+    }
+    return best;
+  };
+  result.Seconds = fastest(caseOf);
+  std::vector<std::uint8_t> cases(static_cast<std::size_t>(tx * ty * tz * 32768), 0);
+  for (int k = 0; k < nz; ++k)
+  {
+    for (int j = 0; j < ny; ++j)
+    {
+      for (int i = 0; i < nx; ++i)
+      {
+        cases[cubeOf(i, j, k)] = static_cast<std::uint8_t>(caseOf(i, j, k));
+      }
+    }
+  }
+  const std::uint8_t* ready = cases.data();
+  result.CasesReady = fastest([=](int i, int j, int k) { return int(ready[cubeOf(i, j, k)]); });
+  result.Nodes = std::move(queue);
+  return result;
+}
+
+/// The least that extraction can do with the nodes of GrowthFloor: the nodes sorted by slab;
+/// each node's triangles, their vertices found or made through slots of the edges in two
+/// planes of grid points and the slab between (cleared where used); each new vertex's position
+/// and normal as vtkMarchingCubes computes them (from the lower end of its edge, the gradients'
+/// central differences interpolated, in double) written to float arrays, the triangles to an
+/// id array. Nothing else (no keys, components, ports, chunks, threads or joins). One thread;
+/// all memory allocated and paged in before the clock starts. Returns the seconds (the minimum
+/// of the repeats); `vertices` is how many it made.
+double ExtractionFloor(
+  const Volume& v, const std::vector<FloorNode>& found, int repeats, long long& vertices)
+{
+  vtkImageData* image = v.Image;
+  int dims[3];
+  image->GetDimensions(dims);
+  double origin[3], spacing[3];
+  image->GetOrigin(origin);
+  image->GetSpacing(spacing);
+  const short* samples =
+    vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars())->GetPointer(0);
+  const std::int64_t sy = dims[0], sz = std::int64_t(dims[0]) * dims[1];
+  auto gradient = [&](int i, int j, int k, double g[3])
+  {
+    // Central differences, one-sided on the volume's border (the index clamped).
+    const int p[3] = { i, j, k };
+    const std::int64_t stride[3] = { 1, sy, sz };
+    const std::int64_t at = i + sy * j + sz * k;
+    for (int a = 0; a < 3; ++a)
+    {
+      const std::int64_t lo = p[a] > 0 ? at - stride[a] : at;
+      const std::int64_t hi = p[a] < dims[a] - 1 ? at + stride[a] : at;
+      const double scale = (p[a] > 0 && p[a] < dims[a] - 1) ? 0.5 : 1.0;
+      g[a] = scale * (static_cast<double>(samples[lo]) - static_cast<double>(samples[hi]));
+    }
+  };
+  const rgmc::CaseTable& table = Table();
+  const std::int64_t nx = dims[0], ny = dims[1];
+  // Per cube edge: its slots' array (0: the lower plane's x and y edges, 1: the upper plane's,
+  // 2: the slab's z edges) and its slot's offset from the cube's.
+  int layerOf[12];
+  std::int64_t slotOffset[12];
+  for (int e = 0; e < 12; ++e)
+  {
+    const int axis = rgmc::CaseTable::EdgeAxis(e);
+    const int* p = rgmc::CornerOffset[rgmc::EdgeCorners[e][0]];
+    layerOf[e] = axis == 2 ? 2 : p[2];
+    slotOffset[e] = axis == 2 ? p[0] + nx * p[1] : 2 * (p[0] + nx * p[1]) + axis;
+  }
+  std::vector<std::int32_t> layers[3] = { std::vector<std::int32_t>(2 * nx * ny, -1),
+    std::vector<std::int32_t>(2 * nx * ny, -1), std::vector<std::int32_t>(nx * ny, -1) };
+  std::vector<std::int64_t> touched[3];
+  for (auto& t : touched)
+  {
+    t.reserve(static_cast<std::size_t>(2 * nx * ny));
+  }
+  std::vector<FloorNode> sorted(found.size());
+  std::vector<std::int64_t> start(static_cast<std::size_t>(dims[2]) + 1), next;
+  long long numTriangles = 0;
+  for (const FloorNode& n : found)
+  {
+    const rgmc::CaseEntry& entry = table[n.Case];
+    for (int t = 0; t < entry.NumTriangles; ++t)
+    {
+      numTriangles += entry.TriangleSheet[t] == n.Sheet;
+    }
+  }
+  // Each vertex belongs to at least one triangle that has 2 others: at most 3 per triangle.
+  std::vector<float> points(9 * numTriangles, 1.0f), normals(9 * numTriangles, 1.0f);
+  std::vector<std::int32_t> triangles(3 * numTriangles, 0);
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r)
+  {
+    const double t0 = Now();
+    std::fill(start.begin(), start.end(), 0);
+    for (const FloorNode& n : found)
+    {
+      ++start[n.K + 1];
+    }
+    for (int k = 0; k < dims[2]; ++k)
+    {
+      start[k + 1] += start[k];
+    }
+    next.assign(start.begin(), start.end() - 1);
+    for (const FloorNode& n : found)
+    {
+      sorted[next[n.K]++] = n;
+    }
+    std::int32_t* slots[3] = { layers[0].data(), layers[1].data(), layers[2].data() };
+    std::int32_t made = 0;
+    std::int64_t t3 = 0;
+    for (int k = 0; k + 1 < dims[2]; ++k)
+    {
+      for (std::int64_t s = start[k]; s < start[k + 1]; ++s)
+      {
+        const FloorNode& n = sorted[s];
+        const rgmc::CaseEntry& entry = table[n.Case];
+        const std::int64_t cube = n.I + nx * n.J;
+        for (int t = 0; t < entry.NumTriangles; ++t)
+        {
+          if (entry.TriangleSheet[t] != n.Sheet)
+          {
+            continue;
+          }
+          for (int c = 0; c < 3; ++c)
+          {
+            const int e = entry.Triangles[t][c];
+            const int layer = layerOf[e];
+            const std::int64_t slot = (layer == 2 ? cube : 2 * cube) + slotOffset[e];
+            std::int32_t id = slots[layer][slot];
+            if (id < 0)
+            {
+              id = made++;
+              slots[layer][slot] = id;
+              touched[layer].push_back(slot);
+              const int axis = rgmc::CaseTable::EdgeAxis(e);
+              const int* o = rgmc::CornerOffset[rgmc::EdgeCorners[e][0]];
+              int p[3] = { n.I + o[0], n.J + o[1], n.K + o[2] };
+              int q[3] = { p[0], p[1], p[2] };
+              ++q[axis];
+              const double sLo = samples[p[0] + sy * p[1] + sz * p[2]];
+              const double sHi = samples[q[0] + sy * q[1] + sz * q[2]];
+              const double along = (v.Isovalue - sLo) / (sHi - sLo);
+              double g0[3], g1[3], w[3];
+              gradient(p[0], p[1], p[2], g0);
+              gradient(q[0], q[1], q[2], g1);
+              for (int a = 0; a < 3; ++a)
+              {
+                const double index = p[a] + (a == axis ? along : 0.0);
+                points[3 * id + a] = static_cast<float>(origin[a] + spacing[a] * index);
+                w[a] = (g0[a] + along * (g1[a] - g0[a])) / spacing[a];
+              }
+              const double length = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+              for (int a = 0; a < 3; ++a)
+              {
+                normals[3 * id + a] = static_cast<float>(length > 0.0 ? w[a] / length : w[a]);
+              }
+            }
+            triangles[t3++] = id;
+          }
+        }
+      }
+      // The upper plane becomes the lower one; the slab's z edges are done.
+      for (const int layer : { 0, 2 })
+      {
+        for (const std::int64_t slot : touched[layer])
+        {
+          slots[layer][slot] = -1;
+        }
+        touched[layer].clear();
+      }
+      std::swap(slots[0], slots[1]);
+      std::swap(touched[0], touched[1]);
+    }
+    for (const std::int64_t slot : touched[0])
+    {
+      slots[0][slot] = -1;
+    }
+    touched[0].clear();
+    best = std::min(best, Now() - t0);
+    vertices = made;
+  }
+  return best;
+}
+
+/// --only floor: the seeded kernel's growth and extraction against GrowthFloor and
+/// ExtractionFloor on the same volume, one thread.
+void FloorRun(const Volume& v, int repeats)
+{
+  if (!vtkShortArray::SafeDownCast(v.Image->GetPointData()->GetScalars()))
+  {
+    std::cerr << v.Name << ": the floors read int16 samples only\n";
+    return;
+  }
+  const Stages stages = KernelStages(v, true, repeats);
+  if (stages.SeedKey < 0)
+  {
+    std::cerr << v.Name << ": no surface near the seed\n";
+    return;
+  }
+  const Floor floor = GrowthFloor(v, stages.SeedKey, repeats);
+  long long floorVertices = 0;
+  const double extraction = ExtractionFloor(v, floor.Nodes, repeats, floorVertices);
+  std::cerr << v.Name << ", 1 thread: growth " << stages.Growth << " s ("
+            << Ns(stages.Growth, stages.Triangles) << " ns/triangle), extraction "
+            << stages.Extraction << " s (" << Ns(stages.Extraction, stages.Triangles)
+            << " ns/triangle), " << stages.Triangles << " triangles, " << stages.Vertices
+            << " vertices; the least node by node: growth " << floor.Seconds << " s ("
+            << Ns(floor.Seconds, floor.Triangles) << " ns/triangle; with every case ready "
+            << floor.CasesReady << " s, " << Ns(floor.CasesReady, floor.Triangles)
+            << " ns/triangle), extraction " << extraction << " s ("
+            << Ns(extraction, floor.Triangles) << " ns/triangle), " << floor.Triangles
+            << " triangles, " << floorVertices << " vertices, " << floor.Nodes.size()
+            << " nodes; growth / least " << stages.Growth / floor.Seconds << ", extraction / least "
+            << stages.Extraction / extraction << "\n";
 }
 
 /// The cost of a triangle on the dense surface, at the current thread count, as JSON: Flying
@@ -357,7 +728,8 @@ int main(int argc, char* argv[])
       repeats = std::atoi(argv[a + 1]);
     }
     else if (arg == "--only" &&
-      (std::string(argv[a + 1]) == "seeded" || std::string(argv[a + 1]) == "all"))
+      (std::string(argv[a + 1]) == "seeded" || std::string(argv[a + 1]) == "all" ||
+        std::string(argv[a + 1]) == "floor"))
     {
       only = argv[a + 1];
     }
@@ -368,7 +740,7 @@ int main(int argc, char* argv[])
     else
     {
       std::cerr << "usage: rgmcKernelBenchmark [--size N] [--ct-size N] [--dense-size N] "
-                   "[--threads 1,2] [--repeats N] [--only seeded|all]\n";
+                   "[--threads 1,2] [--repeats N] [--only seeded|all|floor]\n";
       return 2;
     }
   }
@@ -394,6 +766,12 @@ int main(int argc, char* argv[])
   bool firstRun = true;
   for (const Volume& v : volumes)
   {
+    if (only == "floor")
+    {
+      vtkSMPTools::LocalScope(
+        vtkSMPTools::Config{ 1, "STDThread", false }, [&]() { FloorRun(v, repeats); });
+      continue;
+    }
     for (const int threads : threadCounts)
     {
       vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
