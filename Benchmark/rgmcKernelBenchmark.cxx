@@ -303,6 +303,24 @@ double Ns(double seconds, long long triangles)
   return triangles > 0 ? 1e9 * seconds / static_cast<double>(triangles) : 0.0;
 }
 
+/// The int16 samples of a volume, as the floors read them.
+struct Int16Samples
+{
+  explicit Int16Samples(const Volume& v)
+  {
+    v.Image->GetDimensions(this->Dims);
+    this->Values =
+      vtkShortArray::SafeDownCast(v.Image->GetPointData()->GetScalars())->GetPointer(0);
+    this->Sy = this->Dims[0];
+    this->Sz = this->Sy * this->Dims[1];
+  }
+  std::int64_t Index(int i, int j, int k) const { return i + this->Sy * j + this->Sz * k; }
+
+  int Dims[3];
+  const short* Values;
+  std::int64_t Sy, Sz; // strides of j and k
+};
+
 /// A node of the least growth: a cube and one of its case's sheets.
 struct FloorNode
 {
@@ -331,38 +349,37 @@ struct Floor
 /// design can pay however it gets its cases.
 Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
 {
-  vtkImageData* image = v.Image;
-  int dims[3], extent[6], seedPoint[3], seedAxis;
-  image->GetDimensions(dims);
-  image->GetExtent(extent);
+  const Int16Samples volume(v);
+  int extent[6], seedPoint[3], seedAxis;
+  v.Image->GetExtent(extent);
   rgmc::Grid(extent, extent).Decode(seedKey, seedPoint, seedAxis);
   for (int a = 0; a < 3; ++a)
   {
     seedPoint[a] -= extent[2 * a];
   }
-  const short* samples =
-    vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars())->GetPointer(0);
-  const std::int64_t sy = dims[0], sz = std::int64_t(dims[0]) * dims[1];
+  const std::int64_t sy = volume.Sy, sz = volume.Sz;
   const int above = static_cast<int>(std::ceil(v.Isovalue)); // samples >= it are inside
   auto caseOf = [=](int i, int j, int k)
   {
-    const short* s = samples + i + sy * j + sz * k;
+    const short* s = volume.Values + volume.Index(i, j, k);
     return (s[0] >= above) | (s[1] >= above) << 1 | (s[sy + 1] >= above) << 2 |
       (s[sy] >= above) << 3 | (s[sz] >= above) << 4 | (s[sz + 1] >= above) << 5 |
       (s[sz + sy + 1] >= above) << 6 | (s[sz + sy] >= above) << 7;
   };
-  const int nx = dims[0] - 1, ny = dims[1] - 1, nz = dims[2] - 1; // cubes along each axis
+  // Cubes along each axis.
+  const int nx = volume.Dims[0] - 1, ny = volume.Dims[1] - 1, nz = volume.Dims[2] - 1;
+  auto inside = [=](int i, int j, int k)
+  { return i >= 0 && j >= 0 && k >= 0 && i < nx && j < ny && k < nz; };
   const std::int64_t tx = (nx + 31) / 32, ty = (ny + 31) / 32, tz = (nz + 31) / 32;
   auto cubeOf = [=](int i, int j, int k) // a cube's place in tile order
   {
     return ((i >> 5) + tx * ((j >> 5) + ty * (k >> 5))) * 32768 + (i & 31) +
       32 * ((j & 31) + 32 * (k & 31));
   };
-  using Node = FloorNode;
   const rgmc::CaseTable& table = Table();
   Floor result;
   std::vector<std::uint64_t> found(static_cast<std::size_t>(tx * ty * tz * 512), 0);
-  std::vector<Node> queue;
+  std::vector<FloorNode> queue;
   auto search = [&](auto caseAt)
   {
     queue.clear();
@@ -376,6 +393,7 @@ Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
       {
         return;
       }
+      bool allFound = true; // the cube's bit is set once all its sheets are found
       if (table[c].NumSheets > 1)
       {
         unsigned& mask = sheetsFound[bit];
@@ -384,19 +402,18 @@ Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
           return;
         }
         mask |= 1u << sheet;
-        if (mask != (1u << table[c].NumSheets) - 1)
-        {
-          queue.push_back(Node{ i, j, k, std::uint8_t(c), std::uint8_t(sheet) });
-          return;
-        }
+        allFound = mask == (1u << table[c].NumSheets) - 1;
       }
-      word |= std::uint64_t(1) << (bit & 63);
-      queue.push_back(Node{ i, j, k, std::uint8_t(c), std::uint8_t(sheet) });
+      if (allFound)
+      {
+        word |= std::uint64_t(1) << (bit & 63);
+      }
+      queue.push_back(FloorNode{ i, j, k, std::uint8_t(c), std::uint8_t(sheet) });
     };
     rgmc::ForCubesAround(seedPoint, seedAxis,
       [&](int i, int j, int k, int edge)
       {
-        if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz)
+        if (!inside(i, j, k))
         {
           return;
         }
@@ -412,7 +429,7 @@ Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
     long long made = 0;
     for (std::size_t head = 0; head < queue.size(); ++head)
     {
-      const Node n = queue[head];
+      const FloorNode n = queue[head];
       const rgmc::CaseEntry& entry = table[n.Case];
       for (int t = 0; t < entry.NumTriangles; ++t)
       {
@@ -423,7 +440,7 @@ Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
         for (const rgmc::EdgeNeighbour& step : rgmc::EdgeNeighbourTable[__builtin_ctz(edges)])
         {
           const int i = n.I + step.Offset[0], j = n.J + step.Offset[1], k = n.K + step.Offset[2];
-          if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz)
+          if (!inside(i, j, k))
           {
             continue;
           }
@@ -479,24 +496,21 @@ Floor GrowthFloor(const Volume& v, std::int64_t seedKey, int repeats)
 /// id array. Nothing else (no keys, components, ports, chunks, threads or joins). One thread;
 /// all memory allocated and paged in before the clock starts. Returns the seconds (the minimum
 /// of the repeats); `vertices` is how many it made.
-double ExtractionFloor(
-  const Volume& v, const std::vector<FloorNode>& found, int repeats, long long& vertices)
+double ExtractionFloor(const Volume& v, const Floor& growth, int repeats, long long& vertices)
 {
-  vtkImageData* image = v.Image;
-  int dims[3];
-  image->GetDimensions(dims);
+  const Int16Samples volume(v);
+  const int* dims = volume.Dims;
+  const short* samples = volume.Values;
   double origin[3], spacing[3];
-  image->GetOrigin(origin);
-  image->GetSpacing(spacing);
-  const short* samples =
-    vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars())->GetPointer(0);
-  const std::int64_t sy = dims[0], sz = std::int64_t(dims[0]) * dims[1];
+  v.Image->GetOrigin(origin);
+  v.Image->GetSpacing(spacing);
+  const std::vector<FloorNode>& found = growth.Nodes;
   auto gradient = [&](int i, int j, int k, double g[3])
   {
     // Central differences, one-sided on the volume's border (the index clamped).
     const int p[3] = { i, j, k };
-    const std::int64_t stride[3] = { 1, sy, sz };
-    const std::int64_t at = i + sy * j + sz * k;
+    const std::int64_t stride[3] = { 1, volume.Sy, volume.Sz };
+    const std::int64_t at = volume.Index(i, j, k);
     for (int a = 0; a < 3; ++a)
     {
       const std::int64_t lo = p[a] > 0 ? at - stride[a] : at;
@@ -513,7 +527,7 @@ double ExtractionFloor(
   std::int64_t slotOffset[12];
   for (int e = 0; e < 12; ++e)
   {
-    const int axis = rgmc::CaseTable::EdgeAxis(e);
+    const int axis = rgmc::CubeEdgeAxis[e];
     const int* p = rgmc::CornerOffset[rgmc::EdgeCorners[e][0]];
     layerOf[e] = axis == 2 ? 2 : p[2];
     slotOffset[e] = axis == 2 ? p[0] + nx * p[1] : 2 * (p[0] + nx * p[1]) + axis;
@@ -527,15 +541,7 @@ double ExtractionFloor(
   }
   std::vector<FloorNode> sorted(found.size());
   std::vector<std::int64_t> start(static_cast<std::size_t>(dims[2]) + 1), next;
-  long long numTriangles = 0;
-  for (const FloorNode& n : found)
-  {
-    const rgmc::CaseEntry& entry = table[n.Case];
-    for (int t = 0; t < entry.NumTriangles; ++t)
-    {
-      numTriangles += entry.TriangleSheet[t] == n.Sheet;
-    }
-  }
+  const std::size_t numTriangles = static_cast<std::size_t>(growth.Triangles);
   // Each vertex belongs to at least one triangle that has 2 others: at most 3 per triangle.
   std::vector<float> points(9 * numTriangles, 1.0f), normals(9 * numTriangles, 1.0f);
   std::vector<std::int32_t> triangles(3 * numTriangles, 0);
@@ -584,13 +590,13 @@ double ExtractionFloor(
               id = made++;
               slots[layer][slot] = id;
               touched[layer].push_back(slot);
-              const int axis = rgmc::CaseTable::EdgeAxis(e);
+              const int axis = rgmc::CubeEdgeAxis[e];
               const int* o = rgmc::CornerOffset[rgmc::EdgeCorners[e][0]];
               int p[3] = { n.I + o[0], n.J + o[1], n.K + o[2] };
               int q[3] = { p[0], p[1], p[2] };
               ++q[axis];
-              const double sLo = samples[p[0] + sy * p[1] + sz * p[2]];
-              const double sHi = samples[q[0] + sy * q[1] + sz * q[2]];
+              const double sLo = samples[volume.Index(p[0], p[1], p[2])];
+              const double sHi = samples[volume.Index(q[0], q[1], q[2])];
               const double along = (v.Isovalue - sLo) / (sHi - sLo);
               double g0[3], g1[3], w[3];
               gradient(p[0], p[1], p[2], g0);
@@ -651,7 +657,7 @@ void FloorRun(const Volume& v, int repeats)
   }
   const Floor floor = GrowthFloor(v, stages.SeedKey, repeats);
   long long floorVertices = 0;
-  const double extraction = ExtractionFloor(v, floor.Nodes, repeats, floorVertices);
+  const double extraction = ExtractionFloor(v, floor, repeats, floorVertices);
   std::cerr << v.Name << ", 1 thread: growth " << stages.Growth << " s ("
             << Ns(stages.Growth, stages.Triangles) << " ns/triangle), extraction "
             << stages.Extraction << " s (" << Ns(stages.Extraction, stages.Triangles)
