@@ -29,6 +29,12 @@
 #include <utility>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#elif defined(__aarch64__)
+#include <arm_neon.h>
+#endif
+
 namespace rgmc
 {
 
@@ -492,6 +498,31 @@ private:
   std::vector<Totals> Of;
 };
 
+/// x[v] = sqrt(x[v]) for v < N (N even), two at a time where the processor has them: the
+/// compiler keeps std::sqrt scalar for errno's sake, and a square root is correctly rounded in
+/// any width, so the values are std::sqrt's to the bit.
+template <int N>
+RGMC_INLINE void SquareRoots(double* x)
+{
+  static_assert(N % 2 == 0, "pairs");
+#if defined(__SSE2__)
+  for (int v = 0; v < N; v += 2)
+  {
+    _mm_storeu_pd(x + v, _mm_sqrt_pd(_mm_loadu_pd(x + v)));
+  }
+#elif defined(__aarch64__)
+  for (int v = 0; v < N; v += 2)
+  {
+    vst1q_f64(x + v, vsqrtq_f64(vld1q_f64(x + v)));
+  }
+#else
+  for (int v = 0; v < N; ++v)
+  {
+    x[v] = std::sqrt(x[v]);
+  }
+#endif
+}
+
 /// One rank's piece of the volume: its samples (NaN checked), the cubes it owns, and the
 /// geometry of surface vertices (bitwise identical on every rank: computed from global indices
 /// only).
@@ -789,6 +820,162 @@ public:
         g[a] = g0[a] + t * (g1[a] - g0[a]);
       }
       this->FinishNormal(g, normal);
+    }
+  }
+
+  /// The most vertices PositionsAndNormals takes at once.
+  static constexpr int VertexBatch = 16;
+
+  /// PositionAndNormal of `n` (at most VertexBatch) vertices on the edges leaving p[v] along
+  /// axis[v] (-1: on the grid point p[v]), to the bit: the same operations in the same order,
+  /// each vertex's samples read first and the arithmetic then done over all of them in one loop,
+  /// which the compiler vectorizes (square roots and divisions are correctly rounded in any
+  /// width). Vertices on grid points, near the piece's border or next to a NaN sample take
+  /// PositionAndNormal itself.
+  void PositionsAndNormals(
+    const int (*p)[3], const int* axis, int n, double (*x)[3], float (*normal)[3])
+  {
+    constexpr int B = VertexBatch;
+    if (n <= 0)
+    {
+      return;
+    }
+    const Grid& g = this->GridOf;
+    const std::int64_t sy = g.StrideY, sz = g.StrideZ;
+    const Values& s = this->Samples;
+    // The samples, by vertex: the edge's ends and the gradients' central differences at both.
+    alignas(64) double lo[B], hi[B], idx[3][B], g0[3][B], g1[3][B];
+    bool alone[B];
+    auto central = [this](int i, int j, int k)
+    {
+      return i >= this->CentralLo[0] && i <= this->CentralHi[0] && j >= this->CentralLo[1] &&
+        j <= this->CentralHi[1] && k >= this->CentralLo[2] && k <= this->CentralHi[2];
+    };
+    for (int v = 0; v < B; ++v)
+    {
+      alone[v] = true;
+      lo[v] = 0.0;
+      hi[v] = 1.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        idx[a][v] = g0[a][v] = g1[a][v] = 0.0;
+      }
+      if (v >= n || axis[v] < 0)
+      {
+        continue;
+      }
+      int q[3] = { p[v][0], p[v][1], p[v][2] };
+      ++q[axis[v]];
+      if (!central(p[v][0], p[v][1], p[v][2]) || !central(q[0], q[1], q[2]))
+      {
+        continue;
+      }
+      const std::int64_t at = g.LocalIndex(p[v][0], p[v][1], p[v][2]);
+      const std::int64_t step = axis[v] == 0 ? 1 : (axis[v] == 1 ? sy : sz);
+      const std::int64_t at1 = at + step;
+      lo[v] = static_cast<double>(s[at]);
+      hi[v] = static_cast<double>(s[at1]);
+      g0[0][v] = 0.5 * (static_cast<double>(s[at - 1]) - static_cast<double>(s[at + 1]));
+      g0[1][v] = 0.5 * (static_cast<double>(s[at - sy]) - static_cast<double>(s[at + sy]));
+      g0[2][v] = 0.5 * (static_cast<double>(s[at - sz]) - static_cast<double>(s[at + sz]));
+      g1[0][v] = 0.5 * (static_cast<double>(s[at1 - 1]) - static_cast<double>(s[at1 + 1]));
+      g1[1][v] = 0.5 * (static_cast<double>(s[at1 - sy]) - static_cast<double>(s[at1 + sy]));
+      g1[2][v] = 0.5 * (static_cast<double>(s[at1 - sz]) - static_cast<double>(s[at1 + sz]));
+      bool number = true;
+      if (!std::is_integral<ValueType>::value)
+      {
+        number = lo[v] == lo[v] && hi[v] == hi[v];
+        for (int a = 0; a < 3; ++a)
+        {
+          number = number && g0[a][v] == g0[a][v] && g1[a][v] == g1[a][v];
+        }
+      }
+      if (!number)
+      {
+        continue; // PositionAndNormal names the NaN sample (this lane's arithmetic is dropped)
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        idx[a][v] = static_cast<double>(p[v][a]);
+      }
+      alone[v] = false;
+    }
+    // EdgePosition, Gradient's interpolation and FinishNormal, term by term as they compute.
+    const double iso = this->Options.Isovalue;
+    const auto& m = this->Options.IndexToWorld;
+    const auto& r = this->Options.NormalToWorld;
+    const bool normals = this->Options.ComputeNormals;
+    alignas(64) double t[B], out[3][B], w[3][B];
+    for (int v = 0; v < B; ++v)
+    {
+      t[v] = (iso - lo[v]) / (hi[v] - lo[v]);
+    }
+    for (int v = 0; v < B; ++v)
+    {
+      const int a = axis[v < n ? v : 0];
+      idx[0][v] = a == 0 ? idx[0][v] + t[v] * 1.0 : idx[0][v];
+      idx[1][v] = a == 1 ? idx[1][v] + t[v] * 1.0 : idx[1][v];
+      idx[2][v] = a == 2 ? idx[2][v] + t[v] * 1.0 : idx[2][v];
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      for (int v = 0; v < B; ++v)
+      {
+        out[c][v] = m[c][0] * idx[0][v] + m[c][1] * idx[1][v] + m[c][2] * idx[2][v] + m[c][3];
+      }
+    }
+    if (normals)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        for (int v = 0; v < B; ++v)
+        {
+          g0[a][v] = g0[a][v] + t[v] * (g1[a][v] - g0[a][v]);
+        }
+      }
+      for (int c = 0; c < 3; ++c)
+      {
+        for (int v = 0; v < B; ++v)
+        {
+          w[c][v] = r[c][0] * g0[0][v] + r[c][1] * g0[1][v] + r[c][2] * g0[2][v];
+        }
+      }
+      alignas(64) double len[B];
+      for (int v = 0; v < B; ++v)
+      {
+        len[v] = w[0][v] * w[0][v] + w[1][v] * w[1][v] + w[2][v] * w[2][v];
+      }
+      SquareRoots<B>(len);
+      for (int v = 0; v < B; ++v)
+      {
+        // len > 0: w / len, as FinishNormal; else w / 1, which is w.
+        const double by = len[v] > 0.0 ? len[v] : 1.0;
+        w[0][v] = w[0][v] / by;
+        w[1][v] = w[1][v] / by;
+        w[2][v] = w[2][v] / by;
+      }
+    }
+    for (int v = 0; v < n; ++v)
+    {
+      if (alone[v])
+      {
+        double sLo = 0.0, sHi = 0.0;
+        if (axis[v] >= 0)
+        {
+          int q[3] = { p[v][0], p[v][1], p[v][2] };
+          ++q[axis[v]];
+          sLo = this->Read(p[v][0], p[v][1], p[v][2]);
+          sHi = this->Read(q[0], q[1], q[2]);
+        }
+        normal[v][0] = normal[v][1] = normal[v][2] = 0.0f;
+        this->PositionAndNormal(p[v], axis[v], sLo, sHi, x[v], normal[v]);
+        continue;
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        x[v][a] = out[a][v];
+        normal[v][a] = normals ? static_cast<float>(w[a][v]) : 0.0f;
+      }
     }
   }
 

@@ -11,7 +11,6 @@
 #include "rgmcKeyMap.h"
 
 #include <algorithm>
-#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -645,34 +644,40 @@ private:
         const LocalMesh& from = chunk.Mesh;
         const std::int64_t base = vertexBase[c];
         const std::int64_t nv = from.NumberOfPoints();
-        // Each key decoded once, PrefetchAhead vertices before its use, its samples prefetched
-        // then; the decoded edges wait in a ring.
-        std::array<EdgeOfKey, PrefetchAhead> ring;
-        auto decode = [&](std::int64_t v)
+        // The chunk's own vertices in batches: each batch's keys decoded (and its samples
+        // prefetched) while the batch before is placed.
+        constexpr int B = SampledVolume<Values>::VertexBatch;
+        struct Batch
         {
-          EdgeOfKey& e = ring[v % PrefetchAhead];
-          this->Volume.GridOf.Decode(from.Keys[v], e.P, e.Axis);
-          this->Volume.PrefetchAround(e.P[0], e.P[1], e.P[2]);
+          int P[B][3];
+          int Axis[B];
+          std::int64_t To[B];
+          int N = 0;
+        } batches[2];
+        std::int64_t next = 0;
+        auto fill = [&](Batch& b)
+        {
+          b.N = 0;
+          for (; next < nv && b.N < B; ++next)
+          {
+            const std::int64_t to = chunk.FinalId[next];
+            if (to < base)
+            {
+              continue; // the chunk below's vertex
+            }
+            this->Volume.GridOf.Decode(from.Keys[next], b.P[b.N], b.Axis[b.N]);
+            this->Volume.PrefetchAround(b.P[b.N][0], b.P[b.N][1], b.P[b.N][2]);
+            b.To[b.N++] = to;
+            m.Keys[to] = from.Keys[next];
+            m.VertexComponent[to] = from.VertexComponent[next];
+          }
         };
-        for (std::int64_t v = 0; v < std::min<std::int64_t>(PrefetchAhead, nv); ++v)
+        fill(batches[0]);
+        for (int current = 0; batches[current].N > 0; current = 1 - current)
         {
-          decode(v);
-        }
-        for (std::int64_t v = 0; v < nv; ++v)
-        {
-          const EdgeOfKey edge = ring[v % PrefetchAhead];
-          if (v + PrefetchAhead < nv)
-          {
-            decode(v + PrefetchAhead);
-          }
-          const std::int64_t to = chunk.FinalId[v];
-          if (to < base)
-          {
-            continue; // the chunk below's vertex
-          }
-          this->PlaceVertex(edge, to, doublePoints, normals);
-          m.Keys[to] = from.Keys[v];
-          m.VertexComponent[to] = from.VertexComponent[v];
+          fill(batches[1 - current]);
+          this->PlaceVertices(batches[current].P, batches[current].Axis, batches[current].To,
+            batches[current].N, doublePoints, normals);
         }
         const std::int64_t t0 = triangleBase[c];
         for (std::int64_t t = 0; t < from.NumberOfTriangles(); ++t)
@@ -687,47 +692,34 @@ private:
       });
   }
 
-  /// A vertex's edge, decoded from its key: the grid point and the axis (-1 on a grid point).
-  struct EdgeOfKey
+  /// The positions and normals of `n` vertices on the edges leaving p[v] along axis[v] (-1: on
+  /// the grid point), stored as vertices to[v] of the joined mesh (SampledVolume's
+  /// PositionsAndNormals: vtkMarchingCubes' interpolation from the edge's lower end, the
+  /// gradients' central differences).
+  void PlaceVertices(const int (*p)[3], const int* axis, const std::int64_t* to, int n,
+    bool doublePoints, bool normals)
   {
-    int P[3];
-    int Axis;
-  };
-
-  /// The position and normal of the vertex on `edge` (vtkMarchingCubes' interpolation from the
-  /// edge's lower end, the gradients' central differences), stored as vertex `to` of the joined
-  /// mesh.
-  RGMC_INLINE void PlaceVertex(
-    const EdgeOfKey& edge, std::int64_t to, bool doublePoints, bool normals)
-  {
-    SampledVolume<Values>& volume = this->Volume;
-    int p[3] = { edge.P[0], edge.P[1], edge.P[2] };
-    const int axis = edge.Axis;
-    double sLo = 0.0, sHi = 0.0;
-    if (axis >= 0)
-    {
-      int q[3] = { p[0], p[1], p[2] };
-      ++q[axis];
-      sLo = volume.Read(p[0], p[1], p[2]);
-      sHi = volume.Read(q[0], q[1], q[2]);
-    }
-    double x[3];
-    float normal[3] = { 0, 0, 0 };
-    volume.PositionAndNormal(p, axis, sLo, sHi, x, normal);
+    constexpr int B = SampledVolume<Values>::VertexBatch;
+    double x[B][3];
+    float normal[B][3];
+    this->Volume.PositionsAndNormals(p, axis, n, x, normal);
     LocalMesh& m = this->Mesh;
-    for (int a = 0; a < 3; ++a)
+    for (int v = 0; v < n; ++v)
     {
-      if (doublePoints)
+      for (int a = 0; a < 3; ++a)
       {
-        m.PointsDouble[3 * to + a] = x[a];
-      }
-      else
-      {
-        m.Points[3 * to + a] = static_cast<float>(x[a]);
-      }
-      if (normals)
-      {
-        m.Normals[3 * to + a] = normal[a];
+        if (doublePoints)
+        {
+          m.PointsDouble[3 * to[v] + a] = x[v][a];
+        }
+        else
+        {
+          m.Points[3 * to[v] + a] = static_cast<float>(x[v][a]);
+        }
+        if (normals)
+        {
+          m.Normals[3 * to[v] + a] = normal[v][a];
+        }
       }
     }
   }

@@ -12,7 +12,12 @@
 //     brute force over every cube (Evaluate + Describe), on volumes cut into partial tiles, with
 //     samples equal to the isovalue, and on a piece whose cubes overlap a lower rank's;
 //   - a NaN sample away from the surface (in a region the scan classifies as empty) still
-//     reported by the full scan, naming its grid point.
+//     reported by the full scan, naming its grid point;
+//   - PositionsAndNormals (extraction's vertices in batches) against PositionAndNormal, one
+//     vertex at a time, to the bit: every edge that crosses the isovalue and some grid points,
+//     in batches of every size, in a piece with and without a ghost layer's missing side, with
+//     a rotated, anisotropic index-to-world map, normals on and off, and NaN samples (the same
+//     error).
 #include "rgmcCheck.h"
 #include "rgmcSurfaceKernel.h"
 
@@ -21,6 +26,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <set>
@@ -339,6 +345,145 @@ void CheckNaNAwayFromSurface()
   }
 }
 
+/// PositionsAndNormals against PositionAndNormal on a piece with the local extent `local` of a
+/// 30 x 26 x 22 volume.
+template <typename T>
+void CheckBatchedPositions(const char* what, const int local[6], bool withNaN, bool normals)
+{
+  const int n[3] = { 30, 26, 22 };
+  const int whole[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
+  const std::vector<T> all = Field<T>(n, withNaN);
+  std::vector<T> values;
+  for (int k = local[4]; k <= local[5]; ++k)
+  {
+    for (int j = local[2]; j <= local[3]; ++j)
+    {
+      for (int i = local[0]; i <= local[1]; ++i)
+      {
+        values.push_back(all[i + n[0] * (j + n[1] * static_cast<std::size_t>(k))]);
+      }
+    }
+  }
+  const rgmc::Grid grid(whole, local);
+  const rgmc::Ownership own({ grid.WholeCells() }, 0);
+  rgmc::SurfaceOptions options;
+  options.Isovalue = std::is_integral<T>::value ? 3.0 : 2.75;
+  options.ComputeNormals = normals;
+  // A rotation about z by 30 degrees, spacings 0.7, 1.3 and 2.1, an origin off zero.
+  const double c = std::cos(0.5235987755982988), s = std::sin(0.5235987755982988);
+  const double spacing[3] = { 0.7, 1.3, 2.1 }, origin[3] = { -4.5, 2.25, 10.125 };
+  const double rotation[3][3] = { { c, -s, 0 }, { s, c, 0 }, { 0, 0, 1 } };
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      options.IndexToWorld[r][a] = rotation[r][a] * spacing[a];
+      options.NormalToWorld[r][a] = rotation[r][a] / spacing[a];
+    }
+    options.IndexToWorld[r][3] = origin[r];
+  }
+  // The vertices: every edge of the piece that crosses the isovalue, and every fifth grid point.
+  std::vector<std::array<int, 4>> vertices;
+  for (int k = local[4]; k <= local[5]; ++k)
+  {
+    for (int j = local[2]; j <= local[3]; ++j)
+    {
+      for (int i = local[0]; i <= local[1]; ++i)
+      {
+        const int p[3] = { i, j, k };
+        const double lo = static_cast<double>(values[grid.LocalIndex(i, j, k)]);
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          int q[3] = { i, j, k };
+          ++q[axis];
+          if (q[axis] > local[2 * axis + 1])
+          {
+            continue;
+          }
+          const double hi = static_cast<double>(values[grid.LocalIndex(q[0], q[1], q[2])]);
+          if ((lo >= options.Isovalue) != (hi >= options.Isovalue) || lo != lo || hi != hi)
+          {
+            vertices.push_back({ p[0], p[1], p[2], axis });
+          }
+        }
+        if ((i + 2 * j + 3 * k) % 5 == 0)
+        {
+          vertices.push_back({ p[0], p[1], p[2], -1 });
+        }
+      }
+    }
+  }
+  // One at a time, as extraction placed them before.
+  rgmc::SampledVolume<std::vector<T>> single(Table(), grid, own, values, options);
+  std::vector<double> x1(3 * vertices.size());
+  std::vector<float> n1(3 * vertices.size());
+  for (std::size_t v = 0; v < vertices.size(); ++v)
+  {
+    const int* p = vertices[v].data();
+    const int axis = vertices[v][3];
+    double sLo = 0.0, sHi = 0.0;
+    if (axis >= 0)
+    {
+      int q[3] = { p[0], p[1], p[2] };
+      ++q[axis];
+      sLo = single.Read(p[0], p[1], p[2]);
+      sHi = single.Read(q[0], q[1], q[2]);
+    }
+    float normal[3] = { 0, 0, 0 };
+    single.PositionAndNormal(p, axis, sLo, sHi, &x1[3 * v], normal);
+    std::memcpy(&n1[3 * v], normal, sizeof(normal));
+  }
+  // In batches of 1, 2, ..., VertexBatch vertices, again and again.
+  constexpr int B = rgmc::SampledVolume<std::vector<T>>::VertexBatch;
+  rgmc::SampledVolume<std::vector<T>> batched(Table(), grid, own, values, options);
+  std::vector<double> x2(3 * vertices.size());
+  std::vector<float> n2(3 * vertices.size());
+  int batches = 0;
+  for (std::size_t first = 0; first < vertices.size(); ++batches)
+  {
+    const int count =
+      static_cast<int>(std::min<std::size_t>(1 + batches % B, vertices.size() - first));
+    int p[B][3], axis[B];
+    double x[B][3];
+    float normal[B][3];
+    for (int b = 0; b < count; ++b)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        p[b][a] = vertices[first + b][a];
+      }
+      axis[b] = vertices[first + b][3];
+    }
+    batched.PositionsAndNormals(p, axis, count, x, normal);
+    std::memcpy(&x2[3 * first], x, sizeof(double) * 3 * count);
+    std::memcpy(&n2[3 * first], normal, sizeof(float) * 3 * count);
+    first += count;
+  }
+  std::size_t differ = 0, first = vertices.size();
+  for (std::size_t v = 0; v < vertices.size(); ++v)
+  {
+    if (std::memcmp(&x1[3 * v], &x2[3 * v], 3 * sizeof(double)) != 0 ||
+      std::memcmp(&n1[3 * v], &n2[3 * v], 3 * sizeof(float)) != 0)
+    {
+      first = std::min(first, v);
+      ++differ;
+    }
+  }
+  RGMC_CHECK(differ == 0,
+    what << ": " << differ << " of " << vertices.size()
+         << " vertices differ in batches; the first at (" << vertices[first][0] << ", "
+         << vertices[first][1] << ", " << vertices[first][2] << ") axis " << vertices[first][3]
+         << ": " << x2[3 * first] << " " << x2[3 * first + 1] << " " << x2[3 * first + 2] << " / "
+         << n2[3 * first] << " " << n2[3 * first + 1] << " " << n2[3 * first + 2] << " against "
+         << x1[3 * first] << " " << x1[3 * first + 1] << " " << x1[3 * first + 2] << " / "
+         << n1[3 * first] << " " << n1[3 * first + 1] << " " << n1[3 * first + 2]);
+  RGMC_CHECK(single.Error() == batched.Error(),
+    what << ": one at a time '" << single.Error() << "', in batches '" << batched.Error() << "'");
+  RGMC_CHECK(!withNaN || !batched.Error().empty(), what << ": no NaN reported");
+  std::cout << what << ": " << vertices.size() << " vertices in " << batches
+            << " batches, the same to the bit\n";
+}
+
 } // namespace
 
 int main()
@@ -371,5 +516,13 @@ int main()
   CheckScan("overlapping boxes, rank 0", n, { lower, upper }, 0);
   CheckScan("overlapping boxes, rank 1", n, { lower, upper }, 1);
   CheckNaNAwayFromSurface();
+  const int wholePiece[6] = { 0, 29, 0, 25, 0, 21 };
+  const int ghostPiece[6] = { 4, 22, 0, 17, 3, 21 }; // samples missing beyond it on 4 sides
+  CheckBatchedPositions<short>("positions in batches, int16", wholePiece, false, true);
+  CheckBatchedPositions<short>("positions in batches, int16, a piece", ghostPiece, false, true);
+  CheckBatchedPositions<float>("positions in batches, float", wholePiece, false, true);
+  CheckBatchedPositions<float>("positions in batches, float, no normals", ghostPiece, false, false);
+  CheckBatchedPositions<float>("positions in batches, float with NaN", wholePiece, true, true);
+  CheckBatchedPositions<double>("positions in batches, double, a piece", ghostPiece, false, true);
   return rgmc_test::Result("TestKernelShortcuts");
 }
