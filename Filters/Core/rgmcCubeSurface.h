@@ -841,19 +841,14 @@ public:
       return;
     }
     const Grid& g = this->GridOf;
-    const std::int64_t sy = g.StrideY, sz = g.StrideZ;
-    const Values& s = this->Samples;
     // The samples, by vertex: the edge's ends and the gradients' central differences at both.
     alignas(64) double lo[B], hi[B], idx[3][B], g0[3][B], g1[3][B];
     bool alone[B];
-    auto central = [this](int i, int j, int k)
-    {
-      return i >= this->CentralLo[0] && i <= this->CentralHi[0] && j >= this->CentralLo[1] &&
-        j <= this->CentralHi[1] && k >= this->CentralLo[2] && k <= this->CentralHi[2];
-    };
+    int along[B]; // the lane's edge axis (-1: the lane is not computed here)
     for (int v = 0; v < B; ++v)
     {
       alone[v] = true;
+      along[v] = -1;
       lo[v] = 0.0;
       hi[v] = 1.0;
       for (int a = 0; a < 3; ++a)
@@ -866,21 +861,22 @@ public:
       }
       int q[3] = { p[v][0], p[v][1], p[v][2] };
       ++q[axis[v]];
-      if (!central(p[v][0], p[v][1], p[v][2]) || !central(q[0], q[1], q[2]))
+      if (!this->IsCentral(p[v][0], p[v][1], p[v][2]) || !this->IsCentral(q[0], q[1], q[2]))
       {
         continue;
       }
       const std::int64_t at = g.LocalIndex(p[v][0], p[v][1], p[v][2]);
-      const std::int64_t step = axis[v] == 0 ? 1 : (axis[v] == 1 ? sy : sz);
-      const std::int64_t at1 = at + step;
-      lo[v] = static_cast<double>(s[at]);
-      hi[v] = static_cast<double>(s[at1]);
-      g0[0][v] = 0.5 * (static_cast<double>(s[at - 1]) - static_cast<double>(s[at + 1]));
-      g0[1][v] = 0.5 * (static_cast<double>(s[at - sy]) - static_cast<double>(s[at + sy]));
-      g0[2][v] = 0.5 * (static_cast<double>(s[at - sz]) - static_cast<double>(s[at + sz]));
-      g1[0][v] = 0.5 * (static_cast<double>(s[at1 - 1]) - static_cast<double>(s[at1 + 1]));
-      g1[1][v] = 0.5 * (static_cast<double>(s[at1 - sy]) - static_cast<double>(s[at1 + sy]));
-      g1[2][v] = 0.5 * (static_cast<double>(s[at1 - sz]) - static_cast<double>(s[at1 + sz]));
+      const std::int64_t at1 = at + (axis[v] == 0 ? 1 : (axis[v] == 1 ? g.StrideY : g.StrideZ));
+      lo[v] = static_cast<double>(this->Samples[at]);
+      hi[v] = static_cast<double>(this->Samples[at1]);
+      double d0[3], d1[3];
+      this->CentralDifferences(at, d0);
+      this->CentralDifferences(at1, d1);
+      for (int a = 0; a < 3; ++a)
+      {
+        g0[a][v] = d0[a];
+        g1[a][v] = d1[a];
+      }
       bool number = true;
       if (!std::is_integral<ValueType>::value)
       {
@@ -899,6 +895,7 @@ public:
         idx[a][v] = static_cast<double>(p[v][a]);
       }
       alone[v] = false;
+      along[v] = axis[v];
     }
     // EdgePosition, Gradient's interpolation and FinishNormal, term by term as they compute.
     const double iso = this->Options.Isovalue;
@@ -912,10 +909,9 @@ public:
     }
     for (int v = 0; v < B; ++v)
     {
-      const int a = axis[v < n ? v : 0];
-      idx[0][v] = a == 0 ? idx[0][v] + t[v] * 1.0 : idx[0][v];
-      idx[1][v] = a == 1 ? idx[1][v] + t[v] * 1.0 : idx[1][v];
-      idx[2][v] = a == 2 ? idx[2][v] + t[v] * 1.0 : idx[2][v];
+      idx[0][v] = along[v] == 0 ? idx[0][v] + t[v] * 1.0 : idx[0][v];
+      idx[1][v] = along[v] == 1 ? idx[1][v] + t[v] * 1.0 : idx[1][v];
+      idx[2][v] = along[v] == 2 ? idx[2][v] + t[v] * 1.0 : idx[2][v];
     }
     for (int c = 0; c < 3; ++c)
     {
@@ -1027,21 +1023,33 @@ private:
     }
   }
 
+  /// Whether the gradient at grid point (i, j, k) is central on every axis with samples at
+  /// hand (CentralDifferences applies).
+  RGMC_INLINE bool IsCentral(int i, int j, int k) const
+  {
+    return i >= this->CentralLo[0] && i <= this->CentralHi[0] && j >= this->CentralLo[1] &&
+      j <= this->CentralHi[1] && k >= this->CentralLo[2] && k <= this->CentralHi[2];
+  }
+
+  /// Negative gradient by central differences at the sample with local index `at` (IsCentral).
+  RGMC_INLINE void CentralDifferences(std::int64_t at, double n[3]) const
+  {
+    const std::int64_t sy = this->GridOf.StrideY, sz = this->GridOf.StrideZ;
+    const Values& s = this->Samples;
+    n[0] = 0.5 * (static_cast<double>(s[at - 1]) - static_cast<double>(s[at + 1]));
+    n[1] = 0.5 * (static_cast<double>(s[at - sy]) - static_cast<double>(s[at + sy]));
+    n[2] = 0.5 * (static_cast<double>(s[at - sz]) - static_cast<double>(s[at + sz]));
+  }
+
   /// Negative gradient at a grid point by central differences, one-sided on the volume's
   /// border, as vtkMarchingCubes computes it.
   RGMC_INLINE void Gradient(int i, int j, int k, double n[3])
   {
     const Grid& g = this->GridOf;
-    if (i >= this->CentralLo[0] && i <= this->CentralHi[0] && j >= this->CentralLo[1] &&
-      j <= this->CentralHi[1] && k >= this->CentralLo[2] && k <= this->CentralHi[2])
+    if (this->IsCentral(i, j, k))
     {
       // Central differences on all axes, the samples at hand: the common case.
-      const std::int64_t at = g.LocalIndex(i, j, k);
-      const std::int64_t sy = g.StrideY, sz = g.StrideZ;
-      const Values& s = this->Samples;
-      n[0] = 0.5 * (static_cast<double>(s[at - 1]) - static_cast<double>(s[at + 1]));
-      n[1] = 0.5 * (static_cast<double>(s[at - sy]) - static_cast<double>(s[at + sy]));
-      n[2] = 0.5 * (static_cast<double>(s[at - sz]) - static_cast<double>(s[at + sz]));
+      this->CentralDifferences(g.LocalIndex(i, j, k), n);
       if (std::is_integral<ValueType>::value || (n[0] == n[0] && n[1] == n[1] && n[2] == n[2]))
       {
         return;
