@@ -31,6 +31,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -131,7 +132,8 @@ public:
         tiles *= this->Tiles[a];
       }
       this->Visited.Allocate(static_cast<std::size_t>(tiles * TileWords));
-      this->Work.resize(static_cast<std::size_t>(tiles));
+      this->TileTable.Allocate(static_cast<std::size_t>(tiles));
+      this->NumTiles = tiles;
     }
   }
 
@@ -168,19 +170,23 @@ public:
   std::int64_t CubesExamined() const
   {
     std::int64_t total = this->ScannedCubes;
-    for (const TileWork& w : this->Work)
+    for (const TileWork& w : this->Made)
     {
       total += w.Examined;
     }
     return total;
   }
 
+  /// How many tiles growth has reached so far: those whose state was made (every tile of the
+  /// piece after GrowAll; after seeded growth, the tiles of the nodes found).
+  std::int64_t TilesReached() const { return static_cast<std::int64_t>(this->Made.size()); }
+
   /// How many crossings tiles sent each other, and how many the tiles they went to read (the
   /// same, once no growth is pending: each crossing is read once).
   std::int64_t CrossingsPosted() const
   {
     std::int64_t total = 0;
-    for (const TileWork& w : this->Work)
+    for (const TileWork& w : this->Made)
     {
       total += w.Posted;
     }
@@ -189,7 +195,7 @@ public:
   std::int64_t CrossingsRead() const
   {
     std::int64_t total = 0;
-    for (const TileWork& w : this->Work)
+    for (const TileWork& w : this->Made)
     {
       total += w.Read;
     }
@@ -201,7 +207,7 @@ public:
   /// use the arrival's vertex and were not found yet. Arrivals are taken in the order given.
   void GrowFromArrivals(const std::vector<Arrival>& arrivals, int numLabels)
   {
-    if (this->Work.empty())
+    if (this->NumTiles == 0)
     {
       return;
     }
@@ -244,11 +250,15 @@ public:
   /// "Largest" modes). Each tile is scanned on its own; components are labelled per tile.
   void GrowAll()
   {
-    if (this->Work.empty())
+    if (this->NumTiles == 0)
     {
       return;
     }
-    const std::int64_t numTiles = static_cast<std::int64_t>(this->Work.size());
+    const std::int64_t numTiles = this->NumTiles;
+    for (std::int64_t tile = 0; tile < numTiles; ++tile)
+    {
+      this->MakeWork(tile); // the scan reads every tile
+    }
     std::vector<int> tileComponents(static_cast<std::size_t>(numTiles), 0);
     // Tiles in slabs of tiles along z, for the progress reported between them.
     const std::int64_t perSlab = this->Tiles[0] * this->Tiles[1];
@@ -274,7 +284,7 @@ public:
       {
         this->Components.Add(false);
       }
-      TileWork& w = this->Work[tile];
+      TileWork& w = this->WorkOf(tile);
       for (SurfaceNode& n : w.Queue)
       {
         n.Component += first;
@@ -291,7 +301,7 @@ public:
   void GrowBoundary()
   {
     const Ownership& own = this->Volume.Owned;
-    if (this->Work.empty())
+    if (this->NumTiles == 0)
     {
       return;
     }
@@ -352,6 +362,23 @@ private:
     std::int64_t Posted = 0;       // crossings this tile sent
     std::int64_t Read = 0;         // crossings this tile was sent and read
   };
+
+  /// The state of a tile that growth has reached.
+  RGMC_INLINE TileWork& WorkOf(std::int64_t tile) { return *this->TileTable[tile]; }
+
+  /// The state of tile `tile`, made when growth first reaches it. Tiles are made only between
+  /// parallel steps (a step reads the table, never writes it), so that a surface costs the same
+  /// in any volume: only the tiles it reaches are ever made, visited or freed.
+  TileWork& MakeWork(std::int64_t tile)
+  {
+    TileWork*& w = this->TileTable[tile];
+    if (!w)
+    {
+      this->Made.emplace_back();
+      w = &this->Made.back();
+    }
+    return *w;
+  }
 
   static constexpr int TileCubes = GrowthTileCubes;
   static constexpr int PrefetchAhead = 8; // queued nodes between a prefetch and the expansion
@@ -477,7 +504,7 @@ private:
       this->ExpandByTable(tile, n, keepInTile);
       return;
     }
-    TileWork& w = this->Work[tile];
+    TileWork& w = this->WorkOf(tile);
     CubeSamples st;
     if (!this->Volume.NodeSamples(n, st))
     {
@@ -538,7 +565,7 @@ private:
   /// as Expand does.
   RGMC_INLINE void ExpandByTable(std::int64_t tile, const SurfaceNode& n, bool keepInTile)
   {
-    TileWork& w = this->Work[tile];
+    TileWork& w = this->WorkOf(tile);
     const std::int64_t bit = this->CubeBit(n.I, n.J, n.K);
     const int c[3] = { n.I, n.J, n.K };
     const unsigned room = TileRoom(c, this->Volume.Owned.Mine());
@@ -574,7 +601,7 @@ private:
   /// Expands tile `tile`'s queue from `head` on, inside the tile.
   void ExpandQueue(std::int64_t tile, std::size_t head, bool keepInTile)
   {
-    TileWork& w = this->Work[tile];
+    TileWork& w = this->WorkOf(tile);
     for (; head < w.Queue.size() && !this->Volume.Stopped(); ++head)
     {
       if (head + PrefetchAhead < w.Queue.size())
@@ -602,7 +629,7 @@ private:
           return;
         }
         const std::int64_t tile = this->TileOf(i, j, k);
-        TileWork& w = this->Work[tile];
+        TileWork& w = this->MakeWork(tile);
         const std::size_t before = w.Queue.size();
         this->Visit(w, i, j, k, key, edge, comp, seen);
         if (w.Queue.size() > before)
@@ -617,7 +644,7 @@ private:
   /// the component, or -1 when nothing new was found (`seen` says whether it was found before).
   int GrowFrom(std::int64_t key, const int p[3], int axis, bool seeded, bool* seen)
   {
-    if (this->Work.empty())
+    if (this->NumTiles == 0)
     {
       return -1;
     }
@@ -674,7 +701,7 @@ private:
       std::vector<std::int64_t> next;
       for (const std::int64_t tile : active)
       {
-        TileWork& w = this->Work[tile];
+        TileWork& w = this->WorkOf(tile);
         this->NodesExpanded += static_cast<std::int64_t>(w.Queue.size());
         this->Found.Append(w.Queue); // the queue itself, not a copy
         this->Departures.insert(this->Departures.end(), w.Departures.begin(), w.Departures.end());
@@ -687,17 +714,21 @@ private:
         for (int d = 0; d < 27; ++d)
         {
           const std::int64_t to = tile + this->TileOffset(d);
-          if (mail->Start[d + 1] > mail->Start[d] && this->Work[to].MailRound != round)
+          if (mail->Start[d + 1] > mail->Start[d])
           {
-            this->Work[to].MailRound = round;
-            next.push_back(to);
+            TileWork& receiver = this->MakeWork(to);
+            if (receiver.MailRound != round)
+            {
+              receiver.MailRound = round;
+              next.push_back(to);
+            }
           }
         }
       }
       // The mail of the round before was read in this one.
       for (const std::int64_t tile : this->LastSenders)
       {
-        this->Work[tile].Sent[(round - 1) & 1].reset();
+        this->WorkOf(tile).Sent[(round - 1) & 1].reset();
       }
       this->LastSenders = active;
       std::sort(next.begin(), next.end());
@@ -726,7 +757,7 @@ private:
   /// order, each one's in the order sent.
   void ReadMail(std::int64_t tile, std::int64_t round)
   {
-    TileWork& w = this->Work[tile];
+    TileWork& w = this->WorkOf(tile);
     std::int64_t t[3];
     this->TileCoordinates(tile, t);
     for (int d = 0; d < 27; ++d)
@@ -737,7 +768,8 @@ private:
       {
         continue;
       }
-      const Mail* mail = this->Work[tile + this->TileOffset(d)].Sent[round & 1].get();
+      const TileWork* sender = this->TileTable[tile + this->TileOffset(d)];
+      const Mail* mail = sender ? sender->Sent[round & 1].get() : nullptr;
       if (!mail || mail->Round != round)
       {
         continue;
@@ -756,7 +788,7 @@ private:
   /// they go to (a stable counting sort).
   void PostMail(std::int64_t tile, std::int64_t round)
   {
-    TileWork& w = this->Work[tile];
+    TileWork& w = this->WorkOf(tile);
     if (w.Outbox.empty())
     {
       return;
@@ -859,7 +891,7 @@ private:
   int ScanTile(std::int64_t tile)
   {
     SampledVolume<Values>& volume = this->Volume;
-    TileWork& w = this->Work[tile];
+    TileWork& w = this->WorkOf(tile);
     const CellBox box = this->TileBox(tile);
     const bool holes = !volume.Owned.Overlaps().empty();
     const int cubesPerRow = box.Hi[0] - box.Lo[0] + 1; // at most TileCubes
@@ -975,12 +1007,12 @@ private:
           volume.Describe(i, j, k, st, surface);
           const int numNodes = surface.NumberOfNodes();
           const std::int64_t tile = this->TileOf(i, j, k);
+          TileWork& w = this->MakeWork(tile);
           for (int node = 0; node < numNodes; ++node)
           {
-            if (!this->NodeFound(this->Work[tile], bit, node, numNodes))
+            if (!this->NodeFound(w, bit, node, numNodes))
             {
-              this->Record(
-                this->Work[tile], i, j, k, bit, st, node, numNodes, this->Components.Add(false));
+              this->Record(w, i, j, k, bit, st, node, numNodes, this->Components.Add(false));
               this->Rounds({ tile });
             }
           }
@@ -993,7 +1025,9 @@ private:
   ComponentSet& Components;
   std::int64_t Tiles[3] = { 0, 0, 0 }; // tiles along each axis of the owned box
   ZeroedArray<std::uint64_t> Visited;  // a bit per owned cube: its nodes were all found
-  std::vector<TileWork> Work;          // per tile
+  std::int64_t NumTiles = 0;           // tiles of the owned box (Tiles' product)
+  ZeroedArray<TileWork*> TileTable;    // per tile: its state, null until growth reaches it
+  std::deque<TileWork> Made;           // the tiles' states, in the order made
   NodeList Found;
   std::vector<Departure> Departures;
   std::vector<std::int64_t> Pending;     // tiles with crossings left by the budget, sorted

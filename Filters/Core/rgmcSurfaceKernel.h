@@ -94,6 +94,7 @@ public:
   std::int64_t Joins() const { return this->Extraction.Joins(); }
   std::int64_t CrossingsPosted() const { return this->Growth.CrossingsPosted(); }
   std::int64_t CrossingsRead() const { return this->Growth.CrossingsRead(); }
+  std::int64_t TilesReached() const { return this->Growth.TilesReached(); }
 
   std::string Error() const override { return this->Volume.Error(); }
   bool Aborted() const override { return this->Volume.Aborted(); }

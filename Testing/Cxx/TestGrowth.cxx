@@ -437,6 +437,69 @@ void CostFollowsSurface()
   RGMC_CHECK(reads[1] < 96LL * 96 * 96 / 20, "reads " << reads[1] << " look like a full scan");
 }
 
+/// Seeded growth makes the state of the tiles its nodes lie in and of no other: a small sphere
+/// across tile corners in a volume of 4^3 tiles reaches the 8 tiles around the corner. The
+/// oracle: every cube around an edge of a surface vertex has a node with that vertex (no sample
+/// equals the isovalue here), so the nodes' tiles are those of the cubes around the vertices of
+/// the surface. The full scan reaches every tile.
+void TilesFollowSurface()
+{
+  const int size = 100; // 99 cubes along each axis: 4 tiles of 32 (the last of 3 cubes)
+  Volume vol(size, size, size);
+  for (int k = 0; k < size; ++k)
+  {
+    for (int j = 0; j < size; ++j)
+    {
+      for (int i = 0; i < size; ++i)
+      {
+        const double d =
+          std::sqrt((i - 31.6) * (i - 31.6) + (j - 32.3) * (j - 32.3) + (k - 63.8) * (k - 63.8));
+        vol.At(i, j, k) = static_cast<float>(5.0 - d);
+      }
+    }
+  }
+  const rgmc::Grid grid(vol.Extent, vol.Extent);
+  const rgmc::Ownership own = OwnAll(grid);
+  rgmc::SurfaceOptions params;
+  rgmc::SurfaceKernel<std::vector<float>> seeded(Table(), grid, own, vol.Values, params);
+  const double seed[3] = { 36.6, 32.3, 63.8 };
+  const rgmc::SeedHit hit = seeded.NearestVertex(seed, seed, 10.0, 1.0);
+  RGMC_CHECK(hit.Found, "the sphere is within the radius");
+  seeded.GrowFromKey(hit.Key);
+  seeded.Extract();
+  const rgmc::LocalMesh& mesh = seeded.Mesh();
+  std::set<std::array<int, 3>> tiles;
+  for (std::int64_t v = 0; v < mesh.NumberOfPoints(); ++v)
+  {
+    int p[3], axis;
+    grid.Decode(mesh.Keys[v], p, axis);
+    RGMC_CHECK(axis >= 0, "a vertex on a grid point, where no sample equals the isovalue");
+    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+    for (int du = -1; du <= 0; ++du)
+    {
+      for (int dw = -1; dw <= 0; ++dw)
+      {
+        int c[3] = { p[0], p[1], p[2] };
+        c[u] += du;
+        c[w] += dw;
+        if (c[u] >= 0 && c[u] < size - 1 && c[w] >= 0 && c[w] < size - 1)
+        {
+          tiles.insert({ c[0] / rgmc::GrowthTileCubes, c[1] / rgmc::GrowthTileCubes,
+            c[2] / rgmc::GrowthTileCubes });
+        }
+      }
+    }
+  }
+  RGMC_CHECK(tiles.size() == 8, "the sphere lies in " << tiles.size() << " tiles, not 8");
+  RGMC_CHECK(seeded.TilesReached() == static_cast<std::int64_t>(tiles.size()),
+    "seeded growth reached " << seeded.TilesReached() << " tiles; its nodes lie in "
+                             << tiles.size());
+  rgmc::SurfaceKernel<std::vector<float>> full(Table(), grid, own, vol.Values, params);
+  full.GrowAll();
+  RGMC_CHECK(
+    full.TilesReached() == 64, "the full scan reached " << full.TilesReached() << " tiles of 64");
+}
+
 /// Uniform numbers in [0, 1) from a xorshift generator (the same on every platform).
 struct Random
 {
@@ -583,6 +646,7 @@ int main()
   SplitOwnership();
   RoundsBetweenOwners();
   CostFollowsSurface();
+  TilesFollowSurface();
   TraversalIsComplete();
   CrossingsReachEveryNeighbourTile();
   return rgmc_test::Result("TestGrowth");
