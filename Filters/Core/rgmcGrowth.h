@@ -368,7 +368,8 @@ private:
 
   /// The state of tile `tile`, made when growth first reaches it. Tiles are made only between
   /// parallel steps (a step reads the table, never writes it), so that a surface costs the same
-  /// in any volume: only the tiles it reaches are ever made, visited or freed.
+  /// in any volume: only the tiles it reaches are ever made, visited or freed. The states are
+  /// kept in a deque, so making one moves none: references to others stay valid across it.
   TileWork& MakeWork(std::int64_t tile)
   {
     TileWork*& w = this->TileTable[tile];
