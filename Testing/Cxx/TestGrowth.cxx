@@ -394,6 +394,23 @@ void RoundsBetweenOwners()
   }
 }
 
+/// A sphere: radius - the distance to `centre` (index space), so inside is above 0.
+void FillSphere(Volume& vol, const std::array<double, 3>& centre, double radius)
+{
+  for (int k = 0; k <= vol.Extent[5]; ++k)
+  {
+    for (int j = 0; j <= vol.Extent[3]; ++j)
+    {
+      for (int i = 0; i <= vol.Extent[1]; ++i)
+      {
+        const double d[3] = { i - centre[0], j - centre[1], k - centre[2] };
+        vol.At(i, j, k) =
+          static_cast<float>(radius - std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+      }
+    }
+  }
+}
+
 /// Seeded growth reads the same samples for the same surface, however large the volume.
 void CostFollowsSurface()
 {
@@ -404,18 +421,7 @@ void CostFollowsSurface()
   {
     const int size = sizes[n];
     Volume vol(size, size, size);
-    for (int k = 0; k < size; ++k)
-    {
-      for (int j = 0; j < size; ++j)
-      {
-        for (int i = 0; i < size; ++i)
-        {
-          const double d =
-            std::sqrt((i - 10.3) * (i - 10.3) + (j - 10.7) * (j - 10.7) + (k - 10.1) * (k - 10.1));
-          vol.At(i, j, k) = static_cast<float>(6.0 - d);
-        }
-      }
-    }
+    FillSphere(vol, { 10.3, 10.7, 10.1 }, 6.0);
     const rgmc::Grid grid(vol.Extent, vol.Extent);
     const rgmc::Ownership own = OwnAll(grid);
     rgmc::SurfaceOptions params;
@@ -446,18 +452,7 @@ void TilesFollowSurface()
 {
   const int size = 100; // 99 cubes along each axis: 4 tiles of 32 (the last of 3 cubes)
   Volume vol(size, size, size);
-  for (int k = 0; k < size; ++k)
-  {
-    for (int j = 0; j < size; ++j)
-    {
-      for (int i = 0; i < size; ++i)
-      {
-        const double d =
-          std::sqrt((i - 31.6) * (i - 31.6) + (j - 32.3) * (j - 32.3) + (k - 63.8) * (k - 63.8));
-        vol.At(i, j, k) = static_cast<float>(5.0 - d);
-      }
-    }
-  }
+  FillSphere(vol, { 31.6, 32.3, 63.8 }, 5.0);
   const rgmc::Grid grid(vol.Extent, vol.Extent);
   const rgmc::Ownership own = OwnAll(grid);
   rgmc::SurfaceOptions params;
