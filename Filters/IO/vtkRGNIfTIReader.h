@@ -27,10 +27,10 @@
 #ifndef vtkRGNIfTIReader_h
 #define vtkRGNIfTIReader_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCIOModule.h" // For export macro
 #include "vtkRGVolumeReader.h"
 
-class RGMCFILTERS_EXPORT vtkRGNIfTIReader : public vtkRGVolumeReader
+class RGMCIO_EXPORT vtkRGNIfTIReader : public vtkRGVolumeReader
 {
 public:
   static vtkRGNIfTIReader* New();

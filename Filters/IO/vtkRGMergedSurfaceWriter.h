@@ -39,14 +39,14 @@
 #ifndef vtkRGMergedSurfaceWriter_h
 #define vtkRGMergedSurfaceWriter_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCIOModule.h" // For export macro
 #include "vtkWriter.h"
 
 #include <string> // For Fail
 
 class vtkMultiProcessController;
 
-class RGMCFILTERS_EXPORT vtkRGMergedSurfaceWriter : public vtkWriter
+class RGMCIO_EXPORT vtkRGMergedSurfaceWriter : public vtkWriter
 {
 public:
   static vtkRGMergedSurfaceWriter* New();

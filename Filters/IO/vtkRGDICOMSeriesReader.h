@@ -37,13 +37,13 @@
 #ifndef vtkRGDICOMSeriesReader_h
 #define vtkRGDICOMSeriesReader_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCIOModule.h" // For export macro
 #include "vtkRGVolumeReader.h"
 
 #include <memory> // For std::unique_ptr
 #include <string> // For std::string
 
-class RGMCFILTERS_EXPORT vtkRGDICOMSeriesReader : public vtkRGVolumeReader
+class RGMCIO_EXPORT vtkRGDICOMSeriesReader : public vtkRGVolumeReader
 {
 public:
   static vtkRGDICOMSeriesReader* New();

@@ -70,12 +70,12 @@
 #ifndef vtkRGDecimate_h
 #define vtkRGDecimate_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCReconstructionModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
 class vtkMultiProcessController;
 
-class RGMCFILTERS_EXPORT vtkRGDecimate : public vtkPolyDataAlgorithm
+class RGMCRECONSTRUCTION_EXPORT vtkRGDecimate : public vtkPolyDataAlgorithm
 {
 public:
   static vtkRGDecimate* New();

@@ -33,7 +33,7 @@
 #ifndef vtkRGVolumeReader_h
 #define vtkRGVolumeReader_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCIOModule.h" // For export macro
 #include "vtkImageAlgorithm.h"
 
 #include <string> // For std::string
@@ -48,7 +48,7 @@ class MessageWriter;
 class vtkDataArray;
 class vtkMultiProcessController;
 
-class RGMCFILTERS_EXPORT vtkRGVolumeReader : public vtkImageAlgorithm
+class RGMCIO_EXPORT vtkRGVolumeReader : public vtkImageAlgorithm
 {
 public:
   vtkTypeMacro(vtkRGVolumeReader, vtkImageAlgorithm);

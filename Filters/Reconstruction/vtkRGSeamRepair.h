@@ -62,12 +62,12 @@
 #ifndef vtkRGSeamRepair_h
 #define vtkRGSeamRepair_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCReconstructionModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
 class vtkMultiProcessController;
 
-class RGMCFILTERS_EXPORT vtkRGSeamRepair : public vtkPolyDataAlgorithm
+class RGMCRECONSTRUCTION_EXPORT vtkRGSeamRepair : public vtkPolyDataAlgorithm
 {
 public:
   static vtkRGSeamRepair* New();

@@ -56,7 +56,7 @@ public:
     sent[0] = static_cast<T>(ok ? this->Size : this->Rank);
     std::copy(mine.begin(), mine.end(), sent.begin() + 1);
     ++this->Collectives;
-    if (this->C->AllGather(sent.data(), gathered.data(), static_cast<vtkIdType>(sent.size())) != 1)
+    if (this->MultiProcess->AllGather(sent.data(), gathered.data(), static_cast<vtkIdType>(sent.size())) != 1)
     {
       message = "communication between the ranks failed (agreeing on a status)";
       return false;
@@ -121,45 +121,45 @@ public:
   void AllReduce(const T* mine, T* reduced, vtkIdType n, int op, const char* what)
   {
     ++this->Collectives;
-    this->Check(this->C->AllReduce(mine, reduced, n, op), what);
+    this->Check(this->MultiProcess->AllReduce(mine, reduced, n, op), what);
   }
   template <typename T>
   void AllGather(const T* mine, T* all, vtkIdType n, const char* what)
   {
     ++this->Collectives;
-    this->Check(this->C->AllGather(mine, all, n), what);
+    this->Check(this->MultiProcess->AllGather(mine, all, n), what);
   }
   template <typename T>
   void BroadcastValues(T* values, vtkIdType n, int root, const char* what)
   {
     ++this->Collectives;
-    this->Check(this->C->Broadcast(values, n, root), what);
+    this->Check(this->MultiProcess->Broadcast(values, n, root), what);
   }
   template <typename T>
   void AllGatherV(
     const T* mine, T* all, vtkIdType n, vtkIdType* lengths, vtkIdType* offsets, const char* what)
   {
     ++this->Collectives;
-    this->Check(this->C->AllGatherV(mine, all, n, lengths, offsets), what);
+    this->Check(this->MultiProcess->AllGatherV(mine, all, n, lengths, offsets), what);
   }
   template <typename T>
   void GatherV(const T* mine, T* all, vtkIdType n, vtkIdType* lengths, vtkIdType* offsets, int root,
     const char* what)
   {
     ++this->Collectives;
-    this->Check(this->C->GatherV(mine, all, n, lengths, offsets, root), what);
+    this->Check(this->MultiProcess->GatherV(mine, all, n, lengths, offsets, root), what);
   }
   template <typename T>
   void ScatterV(const T* all, T* mine, vtkIdType* lengths, vtkIdType* offsets, vtkIdType n,
     int root, const char* what)
   {
     ++this->Collectives;
-    this->Check(this->C->ScatterV(all, mine, lengths, offsets, n, root), what);
+    this->Check(this->MultiProcess->ScatterV(all, mine, lengths, offsets, n, root), what);
   }
 
   /// The controller, to hand to a VTK filter that runs on the same ranks (never to call
   /// directly: every collective goes through the counted, checked calls above).
-  vtkMultiProcessController* Controller() const { return this->C; }
+  vtkMultiProcessController* Controller() const { return this->MultiProcess; }
 
   const int Rank;
   const int Size;
@@ -173,7 +173,7 @@ public:
   static constexpr vtkIdType MaxChunk = vtkIdType(1) << 20;
 
 private:
-  vtkMultiProcessController* C;
+  vtkMultiProcessController* MultiProcess;
   std::string Failure;                    // the first failed communication since the last agreement
   std::unique_ptr<std::uint64_t[]> Drain; // MaxChunk values, for messages without memory
 

@@ -10,7 +10,7 @@ namespace rgmc
 Ranks::Ranks(vtkMultiProcessController* controller)
   : Rank(controller->GetLocalProcessId())
   , Size(controller->GetNumberOfProcesses())
-  , C(controller)
+  , MultiProcess(controller)
 {
   // Room to drain a message that finds no memory, reserved now: not touched (so it costs no
   // memory) unless it is needed, when allocating it could fail too.
@@ -59,7 +59,7 @@ bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> an
     mine.push_back(*value);
   }
   ++this->Collectives;
-  if (this->C->AllReduce(mine.data(), reduced.data(), static_cast<vtkIdType>(mine.size()),
+  if (this->MultiProcess->AllReduce(mine.data(), reduced.data(), static_cast<vtkIdType>(mine.size()),
         vtkCommunicator::MIN_OP) != 1)
   {
     // The agreement itself failed: nothing more can be trusted of the other ranks.
@@ -83,7 +83,7 @@ bool Ranks::ShareMessage(int first, std::string& message)
 {
   vtkIdType length = this->Rank == first ? static_cast<vtkIdType>(message.size()) : 0;
   ++this->Collectives;
-  this->C->Broadcast(&length, 1, first);
+  this->MultiProcess->Broadcast(&length, 1, first);
   this->Collectives += length > 0 ? 1 : 0;
   std::vector<char> text(static_cast<std::size_t>(length) + 1, '\0');
   if (this->Rank == first)
@@ -92,7 +92,7 @@ bool Ranks::ShareMessage(int first, std::string& message)
   }
   if (length > 0)
   {
-    this->C->Broadcast(text.data(), length, first);
+    this->MultiProcess->Broadcast(text.data(), length, first);
   }
   message.assign(text.data(), static_cast<std::size_t>(length));
   return false;
@@ -159,13 +159,13 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>
     auto send = [&]()
     {
       const vtkIdType count = static_cast<vtkIdType>(outgoing[partner].size());
-      this->Check(this->C->Send(&count, 1, partner, tag), "sending a message's size");
+      this->Check(this->MultiProcess->Send(&count, 1, partner, tag), "sending a message's size");
       ++this->Messages;
       this->ValuesSent += count;
       for (vtkIdType at = 0; at < count; at += MaxChunk)
       {
         ++this->Messages;
-        this->Check(this->C->Send(outgoing[partner].data() + at, std::min(MaxChunk, count - at),
+        this->Check(this->MultiProcess->Send(outgoing[partner].data() + at, std::min(MaxChunk, count - at),
                       partner, tag + 1),
           "sending a message");
       }
@@ -173,7 +173,7 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>
     auto receive = [&]()
     {
       vtkIdType count = 0;
-      this->Check(this->C->Receive(&count, 1, partner, tag), "receiving a message's size");
+      this->Check(this->MultiProcess->Receive(&count, 1, partner, tag), "receiving a message's size");
       std::vector<T>& in = incoming[partner];
       T* target = nullptr;
       try
@@ -198,7 +198,7 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>
         {
           break; // the agreement that follows fails anyway (Failure is set)
         }
-        this->Check(this->C->Receive(target ? target + at : drain, length, partner, tag + 1),
+        this->Check(this->MultiProcess->Receive(target ? target + at : drain, length, partner, tag + 1),
           "receiving a message");
       }
     };

@@ -23,10 +23,10 @@
 #ifndef vtkRGPhantomSource_h
 #define vtkRGPhantomSource_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCReconstructionModule.h" // For export macro
 #include "vtkImageAlgorithm.h"
 
-class RGMCFILTERS_EXPORT vtkRGPhantomSource : public vtkImageAlgorithm
+class RGMCRECONSTRUCTION_EXPORT vtkRGPhantomSource : public vtkImageAlgorithm
 {
 public:
   static vtkRGPhantomSource* New();

@@ -74,7 +74,7 @@
 #ifndef vtkRGMarchingCubes_h
 #define vtkRGMarchingCubes_h
 
-#include "RGMCFiltersModule.h" // For export macro
+#include "RGMCReconstructionModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
 #include <string> // For DescribeInputProblem
@@ -83,7 +83,7 @@
 class vtkImageData;
 class vtkMultiProcessController;
 
-class RGMCFILTERS_EXPORT vtkRGMarchingCubes : public vtkPolyDataAlgorithm
+class RGMCRECONSTRUCTION_EXPORT vtkRGMarchingCubes : public vtkPolyDataAlgorithm
 {
 public:
   static vtkRGMarchingCubes* New();
