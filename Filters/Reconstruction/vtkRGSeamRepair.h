@@ -170,6 +170,8 @@ private:
   bool RepairSeams(Run& run);
   template <typename T, typename I>
   bool RepairSeamsIn(Run& run);
+  template <typename Repair>
+  bool SmoothSurface(Run& run, Repair& repair);
   bool StoreSurface(Run& run, vtkPolyData* output);
   void BuildOutput(Run& run, vtkPolyData* output);
   void ReportChecks(Run& run, vtkPolyData* output);
