@@ -73,6 +73,8 @@
 #include "RGMCReconstructionModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
+#include <vector> // For the passes' messages
+
 class vtkMultiProcessController;
 
 class RGMCRECONSTRUCTION_EXPORT vtkRGDecimate : public vtkPolyDataAlgorithm
@@ -167,6 +169,21 @@ private:
   bool KeepCheapest(Run& run, bool all);
   bool ApplyCollapses(Run& run);
   bool NumberSurface(Run& run, vtkPolyData* output);
+
+  // The passes' local work, no communication: the steps named by their labels, and the parts
+  // of KeepCheapest between its reductions.
+  using Messages = std::vector<std::vector<vtkIdType>>; // one per rank
+  void ReadPartBounds(Run& run, double bounds[6]);
+  void CountBlockTriangles(Run& run, std::vector<vtkIdType>& counts);
+  void AssignBlocks(Run& run);
+  void ListVertexBlocks(Run& run, Messages& outgoing);
+  void AnswerSharedVertices(Run& run, Messages& asked, Messages& answers);
+  void RecordSharedVertices(Run& run, const Messages& told);
+  void SendTrianglesToBlocks(Run& run, int wave, Messages& outgoing);
+  void AssembleBlocks(Run& run, int wave, Messages& incoming);
+  double SelectThreshold(Run& run, vtkIdType needed);
+  void KeepUpToThreshold(Run& run, double threshold, vtkIdType needed);
+  void BuildDecimatedPiece(Run& run, vtkPolyData* piece);
 };
 
 #endif

@@ -370,8 +370,24 @@ private:
 
   bool CanCollapse(int a, int b, const double position[3])
   {
-    // The edge's two triangles and their third corners.
-    int opposite[2], shared = 0;
+    int opposite[2];
+    if (!this->EdgeCorners(a, b, opposite) || !this->LinkConditionHolds(a, b))
+    {
+      return false;
+    }
+    // Each corner keeps at least three neighbours.
+    if (this->Star[opposite[0]].size() < 4 || this->Star[opposite[1]].size() < 4)
+    {
+      return false;
+    }
+    return this->NoTriangleTurns(a, b, position);
+  }
+
+  // The third corners of the edge's two triangles; false unless it has exactly two, with
+  // different corners.
+  bool EdgeCorners(int a, int b, int opposite[2]) const
+  {
+    int shared = 0;
     for (int t : this->Star[a])
     {
       const auto& tri = this->Triangles[t];
@@ -385,11 +401,12 @@ private:
           tri[0] != a && tri[0] != b ? tri[0] : (tri[1] != a && tri[1] != b ? tri[1] : tri[2]);
       }
     }
-    if (shared != 2 || opposite[0] == opposite[1])
-    {
-      return false;
-    }
-    // The link condition: a and b have no common neighbour but the two corners.
+    return shared == 2 && opposite[0] != opposite[1];
+  }
+
+  // The link condition: a and b have no common neighbour but the two corners.
+  bool LinkConditionHolds(int a, int b)
+  {
     this->Neighbours(a, this->NeighboursA);
     this->Neighbours(b, this->NeighboursB);
     int common = 0;
@@ -410,16 +427,13 @@ private:
         ++j;
       }
     }
-    if (common != 2)
-    {
-      return false;
-    }
-    // Each corner keeps at least three neighbours.
-    if (this->Star[opposite[0]].size() < 4 || this->Star[opposite[1]].size() < 4)
-    {
-      return false;
-    }
-    // No triangle that stays turns over or becomes degenerate.
+    return common == 2;
+  }
+
+  // Whether no triangle that stays turns over or becomes degenerate when a and b merge at
+  // `position`.
+  bool NoTriangleTurns(int a, int b, const double position[3]) const
+  {
     for (int end : { a, b })
     {
       for (int t : this->Star[end])
