@@ -67,8 +67,8 @@ class Walker
 {
 public:
   Walker(Source& source, DicomStructure& result)
-    : S(source)
-    , R(result)
+    : Bytes(source)
+    , Structure(result)
   {
   }
 
@@ -87,9 +87,9 @@ public:
 
   bool Fail(std::uint64_t at, const std::string& what)
   {
-    if (this->R.Problem.empty())
+    if (this->Structure.Problem.empty())
     {
-      this->R.Problem = what + " at byte " + std::to_string(at);
+      this->Structure.Problem = what + " at byte " + std::to_string(at);
     }
     return false;
   }
@@ -106,7 +106,7 @@ public:
   bool Header(std::uint64_t at, std::uint64_t end, const Syntax& sx, Element& e)
   {
     unsigned char b[12];
-    if (at + 8 > end || !this->S.Read(at, b, 8))
+    if (at + 8 > end || !this->Bytes.Read(at, b, 8))
     {
       return this->Fail(at, "an element header runs past the end of the file or its item");
     }
@@ -142,7 +142,7 @@ public:
     }
     if (longForm)
     {
-      if (at + 12 > end || !this->S.Read(at + 8, b + 8, 4))
+      if (at + 12 > end || !this->Bytes.Read(at + 8, b + 8, 4))
       {
         return this->Fail(at, "an element header runs past the end of the file or its item");
       }
@@ -214,9 +214,9 @@ public:
           {
             this->FirstItem = false;
           }
-          else if (!this->S.InMemory)
+          else if (!this->Bytes.InMemory)
           {
-            this->R.Fragments.emplace_back(e.Value, e.Length);
+            this->Structure.Fragments.emplace_back(e.Value, e.Length);
           }
         }
         at = e.Value + e.Length;
@@ -240,17 +240,17 @@ public:
       // What real files carry after their last element, as pydicom and dcmtk accept it: zero
       // bytes (a scanner's padding), or anything after the pixel data.
       // (Not in a deflated data set: GDCM inflates and parses all of it, so its end must hold.)
-      const bool topLevel = depth == 0 && !untilDelimiter && !this->S.InMemory;
+      const bool topLevel = depth == 0 && !untilDelimiter && !this->Bytes.InMemory;
       const bool element = this->Header(at, end, sx, e);
-      if (!element || (topLevel && this->R.HasPixelData && !this->Plausible(e, at, end)))
+      if (!element || (topLevel && this->Structure.HasPixelData && !this->Plausible(e, at, end)))
       {
-        if (!topLevel || !(this->R.HasPixelData || this->ZerosFrom(at, end)))
+        if (!topLevel || !(this->Structure.HasPixelData || this->ZerosFrom(at, end)))
         {
           return false;
         }
-        this->R.Problem.clear();
-        this->R.TrailingBytes = end - at;
-        this->R.DataSetEnd = at;
+        this->Structure.Problem.clear();
+        this->Structure.TrailingBytes = end - at;
+        this->Structure.DataSetEnd = at;
         after = end;
         return true;
       }
@@ -282,20 +282,21 @@ public:
         }
         if (topPixelData)
         {
-          this->R.HasPixelData = true;
-          this->R.PixelDataEncapsulated = true;
+          this->Structure.HasPixelData = true;
+          this->Structure.PixelDataEncapsulated = true;
         }
         at = next;
         continue;
       }
       if (topPixelData)
       {
-        this->R.HasPixelData = true;
-        this->R.PixelDataDeclared = e.Length;
-        this->R.PixelDataOffset = this->S.InMemory ? 0 : e.Value;
-        this->R.PixelDataWords = e.VR[0] == 'O' && e.VR[1] == 'W';
-        this->R.PixelDataLength =
-          e.Value >= this->S.Size ? 0 : std::min<std::uint64_t>(e.Length, this->S.Size - e.Value);
+        this->Structure.HasPixelData = true;
+        this->Structure.PixelDataDeclared = e.Length;
+        this->Structure.PixelDataOffset = this->Bytes.InMemory ? 0 : e.Value;
+        this->Structure.PixelDataWords = e.VR[0] == 'O' && e.VR[1] == 'W';
+        this->Structure.PixelDataLength = e.Value >= this->Bytes.Size
+          ? 0
+          : std::min<std::uint64_t>(e.Length, this->Bytes.Size - e.Value);
         if (e.Value + e.Length > end)
         {
           // A short native pixel data: reported as truncated by the reader, with both lengths.
@@ -323,18 +324,24 @@ public:
       }
       if (depth == 0 && e.Group == 0x0002 && e.Number == 0x0010 && e.Length < 256)
       {
-        std::string uid(e.Length, '\0');
-        this->S.Read(e.Value, &uid[0], e.Length);
-        while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' '))
-        {
-          uid.pop_back();
-        }
-        this->R.TransferSyntax = uid;
+        this->Structure.TransferSyntax = this->Uid(e);
       }
       at = e.Value + e.Length;
     }
     after = at;
     return true;
+  }
+
+  /// The value of a UI element (TransferSyntaxUID), without its padding.
+  std::string Uid(const Element& e)
+  {
+    std::string uid(e.Length, '\0');
+    this->Bytes.Read(e.Value, &uid[0], e.Length);
+    while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' '))
+    {
+      uid.pop_back();
+    }
+    return uid;
   }
 
   /// Whether the bytes from `at` to `end` are all zero.
@@ -345,7 +352,7 @@ public:
     {
       const std::size_t n =
         static_cast<std::size_t>(std::min<std::uint64_t>(sizeof block, end - at));
-      if (!this->S.Read(at, block, n))
+      if (!this->Bytes.Read(at, block, n))
       {
         return false;
       }
@@ -381,8 +388,8 @@ public:
     return s;
   }
 
-  Source& S;
-  DicomStructure& R;
+  Source& Bytes;             // the file, or the inflated data set
+  DicomStructure& Structure; // what the walk finds
   bool FirstItem = true;
   std::uint32_t LastTopTag = 0;
 };
@@ -578,6 +585,94 @@ bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t
   return true;
 }
 
+namespace
+{
+
+/// The file meta information of a Part 10 file, from `at` (after the preamble and "DICM"):
+/// explicit VR little endian, group 0002 only. `at` ends after it; false, with the problem said,
+/// when it is truncated or corrupt.
+bool ReadFileMeta(Source& source, Walker& walker, DicomStructure& result, std::uint64_t& at)
+{
+  while (true)
+  {
+    unsigned char tag[2];
+    if (!source.Read(at, tag, 2) || (tag[0] | (tag[1] << 8)) != 0x0002)
+    {
+      return true;
+    }
+    Walker::Element e;
+    if (!walker.Header(at, source.Size, Syntax{ true, false }, e) || e.Length == Undefined ||
+      e.Value + e.Length > source.Size)
+    {
+      if (result.Problem.empty())
+      {
+        result.Problem =
+          "its file meta information is truncated or corrupt at byte " + std::to_string(at);
+      }
+      return false;
+    }
+    if (e.Number == 0x0010 && e.Length < 256)
+    {
+      result.TransferSyntax = walker.Uid(e);
+    }
+    at = e.Value + e.Length;
+  }
+}
+
+/// The syntax of the data set at `at`, from the transfer syntax `ts`. Some files declare
+/// explicit VR and hold implicit VR (or the reverse): as pydicom and GDCM do, the first data set
+/// element decides.
+Syntax DataSetSyntax(Source& source, const std::string& ts, std::uint64_t at)
+{
+  Syntax sx;
+  sx.Explicit = ts != "1.2.840.10008.1.2" && ts != "1.2.840.113619.5.2" && !ts.empty();
+  sx.BigEndian = ts == "1.2.840.10008.1.2.2" || ts == "1.2.840.113619.5.2";
+  unsigned char b[6];
+  if (ts != "1.2.840.10008.1.2.1.99" && source.Read(at, b, 6))
+  {
+    sx.Explicit = b[4] >= 'A' && b[4] <= 'Z' && b[5] >= 'A' && b[5] <= 'Z';
+  }
+  return sx;
+}
+
+/// A deflated data set, from `at` to the end of the file: walked once inflated in memory.
+void WalkDeflated(Source& source, std::uint64_t at, const Syntax& sx, DicomStructure& result)
+{
+  std::vector<unsigned char> inflated;
+  if (!Inflate(source, at, inflated))
+  {
+    result.Problem = "its deflated data set does not inflate (truncated or corrupt)";
+    return;
+  }
+  Source memory(std::move(inflated));
+  DicomStructure inner;
+  Walker innerWalker(memory, inner);
+  std::uint64_t after = 0;
+  result.Valid = innerWalker.DataSet(0, memory.Size, false, sx, 0, after);
+  result.Problem = inner.Problem;
+  result.HasPixelData = inner.HasPixelData;
+  result.PixelDataEncapsulated = inner.PixelDataEncapsulated;
+  result.PixelDataLength = inner.PixelDataLength;
+  result.PixelDataDeclared = inner.PixelDataDeclared;
+}
+
+/// A bare data set (no preamble): it starts with a small group (0008 usually), in either VR
+/// form; anything else is not DICOM.
+void WalkBareDataSet(Source& source, Walker& walker, DicomStructure& result)
+{
+  unsigned char b[8];
+  if (!source.Read(0, b, 8) || b[1] != 0 || b[0] == 0 || b[0] > 0x28 || b[3] != 0)
+  {
+    return; // not DICOM
+  }
+  result.Dicom = true;
+  const bool explicitVR = b[4] >= 'A' && b[4] <= 'Z' && b[5] >= 'A' && b[5] <= 'Z';
+  std::uint64_t after = 0;
+  result.Valid = walker.DataSet(0, source.Size, false, Syntax{ explicitVR, false }, 0, after);
+}
+
+} // namespace
+
 DicomStructure WalkDicom(const std::string& path)
 {
   DicomStructure result;
@@ -588,92 +683,26 @@ DicomStructure WalkDicom(const std::string& path)
     return result;
   }
   unsigned char head[132];
-  std::uint64_t at = 0;
   Walker walker(source, result);
-  if (source.Read(0, head, 132) && std::memcmp(head + 128, "DICM", 4) == 0)
+  if (!source.Read(0, head, 132) || std::memcmp(head + 128, "DICM", 4) != 0)
   {
-    result.Dicom = true;
-    at = 132;
-    // The file meta information: explicit VR little endian, group 0002 only.
-    while (true)
-    {
-      unsigned char tag[2];
-      if (!source.Read(at, tag, 2) || (tag[0] | (tag[1] << 8)) != 0x0002)
-      {
-        break;
-      }
-      Walker::Element e;
-      if (!walker.Header(at, source.Size, Syntax{ true, false }, e) || e.Length == Undefined ||
-        e.Value + e.Length > source.Size)
-      {
-        if (result.Problem.empty())
-        {
-          result.Problem =
-            "its file meta information is truncated or corrupt at byte " + std::to_string(at);
-        }
-        return result;
-      }
-      if (e.Number == 0x0010 && e.Length < 256)
-      {
-        std::string uid(e.Length, '\0');
-        source.Read(e.Value, &uid[0], e.Length);
-        while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' '))
-        {
-          uid.pop_back();
-        }
-        result.TransferSyntax = uid;
-      }
-      at = e.Value + e.Length;
-    }
-  }
-  else
-  {
-    // A bare data set: it starts with a small group (0008 usually), in either VR form.
-    unsigned char b[8];
-    if (!source.Read(0, b, 8) || b[1] != 0 || b[0] == 0 || b[0] > 0x28 || b[3] != 0)
-    {
-      return result; // not DICOM
-    }
-    result.Dicom = true;
-    const bool explicitVR = b[4] >= 'A' && b[4] <= 'Z' && b[5] >= 'A' && b[5] <= 'Z';
-    std::uint64_t after = 0;
-    result.Valid = walker.DataSet(0, source.Size, false, Syntax{ explicitVR, false }, 0, after);
+    WalkBareDataSet(source, walker, result);
     return result;
   }
-  const std::string& ts = result.TransferSyntax;
-  Syntax sx;
-  sx.Explicit = ts != "1.2.840.10008.1.2" && ts != "1.2.840.113619.5.2" && !ts.empty();
-  sx.BigEndian = ts == "1.2.840.10008.1.2.2" || ts == "1.2.840.113619.5.2";
-  result.BigEndian = sx.BigEndian;
-  // Some files declare explicit VR and hold implicit VR (or the reverse): as pydicom and GDCM
-  // do, the first data set element decides.
+  result.Dicom = true;
+  std::uint64_t at = 132;
+  if (!ReadFileMeta(source, walker, result, at))
   {
-    unsigned char b[6];
-    if (ts != "1.2.840.10008.1.2.1.99" && source.Read(at, b, 6))
-    {
-      sx.Explicit = b[4] >= 'A' && b[4] <= 'Z' && b[5] >= 'A' && b[5] <= 'Z';
-    }
+    return result;
+  }
+  const Syntax sx = DataSetSyntax(source, result.TransferSyntax, at);
+  result.BigEndian = sx.BigEndian;
+  if (result.TransferSyntax == "1.2.840.10008.1.2.1.99")
+  {
+    WalkDeflated(source, at, sx, result);
+    return result;
   }
   std::uint64_t after = 0;
-  if (ts == "1.2.840.10008.1.2.1.99")
-  {
-    std::vector<unsigned char> inflated;
-    if (!Inflate(source, at, inflated))
-    {
-      result.Problem = "its deflated data set does not inflate (truncated or corrupt)";
-      return result;
-    }
-    Source memory(std::move(inflated));
-    DicomStructure inner;
-    Walker innerWalker(memory, inner);
-    result.Valid = innerWalker.DataSet(0, memory.Size, false, sx, 0, after);
-    result.Problem = inner.Problem;
-    result.HasPixelData = inner.HasPixelData;
-    result.PixelDataEncapsulated = inner.PixelDataEncapsulated;
-    result.PixelDataLength = inner.PixelDataLength;
-    result.PixelDataDeclared = inner.PixelDataDeclared;
-    return result;
-  }
   result.Valid = walker.DataSet(at, source.Size, false, sx, 0, after);
   return result;
 }

@@ -358,7 +358,7 @@ public:
     Int firstTriangle, bool normals, bool doublePoints)
     : Kind(format)
     , Binary(binary)
-    , M(mesh)
+    , LocalMesh(mesh)
     , Vertices(vertices)
     , Triangles(triangles)
     , FirstTriangle(firstTriangle)
@@ -402,76 +402,14 @@ public:
     switch (this->Kind)
     {
       case Format::STL:
-        if (this->Binary)
-        {
-          // Padded with NULs: STL tools print the header as a C string (admesh 0.98.5 printed
-          // the triangle count's bytes after a header padded with spaces).
-          std::string header = "RGMC merged surface (binary STL)";
-          header.resize(80, '\0');
-          char count[4];
-          PutLittleEndian(count, static_cast<std::uint32_t>(this->Triangles));
-          this->L.Text(header + std::string(count, 4));
-          this->TriangleBlock = this->L.Records(this->Triangles, triangle);
-        }
-        else
-        {
-          this->L.Text("solid rgmc\n");
-          this->TriangleBlock = this->L.Records(this->Triangles, triangle);
-          this->L.Text("endsolid rgmc\n");
-        }
+        this->PlanStl(triangle);
         break;
       case Format::PLY:
-      {
-        const std::string real = this->DoublePoints ? "double" : "float";
-        std::string header = std::string("ply\nformat ") +
-          (this->Binary ? "binary_little_endian" : "ascii") +
-          " 1.0\ncomment RGMC merged surface\nelement vertex " + std::to_string(this->Vertices) +
-          "\nproperty " + real + " x\nproperty " + real + " y\nproperty " + real + " z\n";
-        if (this->WithNormals)
-        {
-          header += "property float nx\nproperty float ny\nproperty float nz\n";
-        }
-        header += "element face " + std::to_string(this->Triangles) + "\nproperty list uchar " +
-          (this->Vertices > std::numeric_limits<std::int32_t>::max() ? "uint" : "int") +
-          " vertex_indices\nend_header\n";
-        this->L.Text(header);
-        // A PLY vertex is its coordinates then its normal: one record of both.
-        this->PointBlock = this->L.Records(this->Vertices, point + normal);
-        this->NormalBlock = Block{ this->PointBlock.Start + point, point + normal };
-        this->TriangleBlock = this->L.Records(this->Triangles, triangle);
+        this->PlanPly(point, normal, triangle);
         break;
-      }
       case Format::VTP:
-      {
-        const Int realBytes = this->DoublePoints ? 8 : 4;
-        this->L.Text("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
-                     "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PolyData>\n    "
-                     "<Piece NumberOfPoints=\"" +
-          std::to_string(this->Vertices) +
-          "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
-          std::to_string(this->Triangles) + "\">\n");
-        if (this->WithNormals)
-        {
-          this->L.Text("      <PointData Normals=\"Normals\">\n" +
-            this->ArrayStart("Float32", "Normals", 3, 12 * this->Vertices, this->Binary));
-          this->NormalBlock = this->L.Records(this->Vertices, normal);
-          this->L.Text("\n        </DataArray>\n      </PointData>\n");
-        }
-        this->L.Text("      <Points>\n" +
-          this->ArrayStart(this->DoublePoints ? "Float64" : "Float32", "Points", 3,
-            3 * realBytes * this->Vertices, this->Binary));
-        this->PointBlock = this->L.Records(this->Vertices, point);
-        this->L.Text("\n        </DataArray>\n      </Points>\n      <Polys>\n" +
-          this->ArrayStart("Int64", "connectivity", 1, 24 * this->Triangles, this->Binary));
-        this->TriangleBlock = this->L.Records(this->Triangles, triangle);
-        // 8-byte offsets cannot be placed by byte range in base64: fixed-width text always.
-        this->L.Text(
-          "\n        </DataArray>\n" + this->ArrayStart("Int64", "offsets", 1, 0, false));
-        this->OffsetBlock = this->L.Records(this->Triangles, offset);
-        this->L.Text(
-          "        </DataArray>\n      </Polys>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
+        this->PlanVtp(point, normal, triangle, offset);
         break;
-      }
     }
   }
 
@@ -481,7 +419,7 @@ public:
   {
     if (texts)
     {
-      for (const auto& text : this->L.Texts)
+      for (const auto& text : this->FileLayout.Texts)
       {
         file.Write(text.first, text.second.data(), text.second.size());
       }
@@ -489,10 +427,10 @@ public:
     char record[RecordCapacity];
     const bool interleaved = this->Kind == Format::PLY;
     // STL has no vertex list: its triangles carry their corners.
-    for (const auto& owned : this->Kind == Format::STL ? NoVertices : this->M.Owned)
+    for (const auto& owned : this->Kind == Format::STL ? NoVertices : this->LocalMesh.Owned)
     {
       double x[3];
-      this->M.Points->GetPoint(owned.second, x);
+      this->LocalMesh.Points->GetPoint(owned.second, x);
       const char end = interleaved && this->WithNormals ? ' ' : '\n';
       if (!this->Put(file, this->PointBlock, owned.first,
             this->PointRecord(record, x, this->DoublePoints, end), this->PointLength, record))
@@ -501,7 +439,7 @@ public:
       }
       if (interleaved && this->WithNormals)
       {
-        this->M.Normals->GetTuple(owned.second, x);
+        this->LocalMesh.Normals->GetTuple(owned.second, x);
         if (!this->Put(file, this->NormalBlock, owned.first, this->PointRecord(record, x, false),
               this->NormalLength, record))
         {
@@ -511,10 +449,10 @@ public:
     }
     if (!interleaved && this->WithNormals)
     {
-      for (const auto& owned : this->M.Owned)
+      for (const auto& owned : this->LocalMesh.Owned)
       {
         double n[3];
-        this->M.Normals->GetTuple(owned.second, n);
+        this->LocalMesh.Normals->GetTuple(owned.second, n);
         if (!this->Put(file, this->NormalBlock, owned.first, this->PointRecord(record, n, false),
               this->NormalLength, record))
         {
@@ -522,13 +460,13 @@ public:
         }
       }
     }
-    const Int count = static_cast<Int>(this->M.Triangles.size() / 3);
+    const Int count = static_cast<Int>(this->LocalMesh.Triangles.size() / 3);
     for (Int t = 0; t < count; ++t)
     {
       const Int index = this->FirstTriangle + t;
       if (!this->Put(file, this->TriangleBlock, index,
-            this->TriangleRecord(record, &this->M.Triangles[3 * t], false), this->TriangleLength,
-            record))
+            this->TriangleRecord(record, &this->LocalMesh.Triangles[3 * t], false),
+            this->TriangleLength, record))
       {
         return false;
       }
@@ -545,12 +483,88 @@ public:
     return true;
   }
 
-  Int Size() const { return this->L.End; }
+  Int Size() const { return this->FileLayout.End; }
   std::string Problem;
 
 private:
   static constexpr std::size_t RecordCapacity = 1024;
   static const std::vector<std::pair<Int, vtkIdType>> NoVertices;
+
+  // STL: a header, then the facets.
+  void PlanStl(Int triangle)
+  {
+    if (this->Binary)
+    {
+      // Padded with NULs: STL tools print the header as a C string (admesh 0.98.5 prints
+      // the triangle count's bytes after a header padded with spaces).
+      std::string header = "RGMC merged surface (binary STL)";
+      header.resize(80, '\0');
+      char count[4];
+      PutLittleEndian(count, static_cast<std::uint32_t>(this->Triangles));
+      this->FileLayout.Text(header + std::string(count, 4));
+      this->TriangleBlock = this->FileLayout.Records(this->Triangles, triangle);
+    }
+    else
+    {
+      this->FileLayout.Text("solid rgmc\n");
+      this->TriangleBlock = this->FileLayout.Records(this->Triangles, triangle);
+      this->FileLayout.Text("endsolid rgmc\n");
+    }
+  }
+
+  // PLY: a header, the vertices (coordinates and normal in one record), the faces.
+  void PlanPly(Int point, Int normal, Int triangle)
+  {
+    const std::string real = this->DoublePoints ? "double" : "float";
+    std::string header = std::string("ply\nformat ") +
+      (this->Binary ? "binary_little_endian" : "ascii") +
+      " 1.0\ncomment RGMC merged surface\nelement vertex " + std::to_string(this->Vertices) +
+      "\nproperty " + real + " x\nproperty " + real + " y\nproperty " + real + " z\n";
+    if (this->WithNormals)
+    {
+      header += "property float nx\nproperty float ny\nproperty float nz\n";
+    }
+    header += "element face " + std::to_string(this->Triangles) + "\nproperty list uchar " +
+      (this->Vertices > std::numeric_limits<std::int32_t>::max() ? "uint" : "int") +
+      " vertex_indices\nend_header\n";
+    this->FileLayout.Text(header);
+    // A PLY vertex is its coordinates then its normal: one record of both.
+    this->PointBlock = this->FileLayout.Records(this->Vertices, point + normal);
+    this->NormalBlock = Block{ this->PointBlock.Start + point, point + normal };
+    this->TriangleBlock = this->FileLayout.Records(this->Triangles, triangle);
+  }
+
+  // VTP: the XML around inline arrays: normals, points, connectivity, offsets.
+  void PlanVtp(Int point, Int normal, Int triangle, Int offset)
+  {
+    const Int realBytes = this->DoublePoints ? 8 : 4;
+    this->FileLayout.Text("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
+                          "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PolyData>\n    "
+                          "<Piece NumberOfPoints=\"" +
+      std::to_string(this->Vertices) +
+      "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
+      std::to_string(this->Triangles) + "\">\n");
+    if (this->WithNormals)
+    {
+      this->FileLayout.Text("      <PointData Normals=\"Normals\">\n" +
+        this->ArrayStart("Float32", "Normals", 3, 12 * this->Vertices, this->Binary));
+      this->NormalBlock = this->FileLayout.Records(this->Vertices, normal);
+      this->FileLayout.Text("\n        </DataArray>\n      </PointData>\n");
+    }
+    this->FileLayout.Text("      <Points>\n" +
+      this->ArrayStart(this->DoublePoints ? "Float64" : "Float32", "Points", 3,
+        3 * realBytes * this->Vertices, this->Binary));
+    this->PointBlock = this->FileLayout.Records(this->Vertices, point);
+    this->FileLayout.Text("\n        </DataArray>\n      </Points>\n      <Polys>\n" +
+      this->ArrayStart("Int64", "connectivity", 1, 24 * this->Triangles, this->Binary));
+    this->TriangleBlock = this->FileLayout.Records(this->Triangles, triangle);
+    // 8-byte offsets cannot be placed by byte range in base64: fixed-width text always.
+    this->FileLayout.Text(
+      "\n        </DataArray>\n" + this->ArrayStart("Int64", "offsets", 1, 0, false));
+    this->OffsetBlock = this->FileLayout.Records(this->Triangles, offset);
+    this->FileLayout.Text(
+      "        </DataArray>\n      </Polys>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
+  }
 
   // Places a record of `length` bytes, which must be `expected`, at index `index` of `block`.
   bool Put(
@@ -603,82 +617,15 @@ private:
   // One triangle: STL's facet with its own normal and vertices, PLY's face, VTP's connectivity.
   Int TriangleRecord(char* out, const vtkIdType* local, bool sample) const
   {
-    char* start = out;
     if (this->Kind == Format::STL)
     {
-      float f[3][3] = {};
-      for (int v = 0; v < 3 && !sample; ++v)
-      {
-        double x[3];
-        this->M.Points->GetPoint(local[v], x);
-        for (int k = 0; k < 3; ++k)
-        {
-          f[v][k] = static_cast<float>(x[k]);
-        }
-      }
-      double a[3], b[3], n[3];
-      for (int k = 0; k < 3; ++k)
-      {
-        a[k] = static_cast<double>(f[1][k]) - f[0][k];
-        b[k] = static_cast<double>(f[2][k]) - f[0][k];
-      }
-      n[0] = a[1] * b[2] - a[2] * b[1];
-      n[1] = a[2] * b[0] - a[0] * b[2];
-      n[2] = a[0] * b[1] - a[1] * b[0];
-      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      for (int k = 0; k < 3 && length > 0; ++k)
-      {
-        n[k] /= length;
-      }
-      if (this->Binary)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          out = PutLittleEndian(out, static_cast<float>(n[k]));
-        }
-        for (int v = 0; v < 3; ++v)
-        {
-          for (int k = 0; k < 3; ++k)
-          {
-            out = PutLittleEndian(out, f[v][k]);
-          }
-        }
-        out = PutLittleEndian(out, std::uint16_t(0));
-        return out - start;
-      }
-      char r[3][32];
-      auto reals = [&r](const double* values)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          if (FixedReal(r[k], values[k], false) != 15)
-          {
-            return false;
-          }
-        }
-        return true;
-      };
-      if (!reals(n))
-      {
-        return -1;
-      }
-      out += std::sprintf(out, "facet normal %s %s %s\n  outer loop\n", r[0], r[1], r[2]);
-      for (int v = 0; v < 3; ++v)
-      {
-        const double x[3] = { f[v][0], f[v][1], f[v][2] };
-        if (!reals(x))
-        {
-          return -1;
-        }
-        out += std::sprintf(out, "    vertex %s %s %s\n", r[0], r[1], r[2]);
-      }
-      out += std::sprintf(out, "  endloop\nendfacet\n");
-      return out - start;
+      return this->FacetRecord(out, local, sample);
     }
+    char* start = out;
     Int g[3] = { 0, 0, 0 };
     for (int v = 0; v < 3 && !sample; ++v)
     {
-      g[v] = this->M.Ids->GetValue(local[v]);
+      g[v] = this->LocalMesh.Ids->GetValue(local[v]);
     }
     const bool wide = this->Vertices > std::numeric_limits<std::int32_t>::max();
     if (this->Kind == Format::PLY && this->Binary)
@@ -706,6 +653,87 @@ private:
       this->Kind == Format::PLY ? "3 %*lld %*lld %*lld\n" : "%*lld %*lld %*lld\n", this->IdWidth,
       static_cast<long long>(g[0]), this->IdWidth, static_cast<long long>(g[1]), this->IdWidth,
       static_cast<long long>(g[2]));
+  }
+
+  // STL's facet: the normal of its corners as float, then the corners (a sample's are zeros).
+  Int FacetRecord(char* out, const vtkIdType* local, bool sample) const
+  {
+    char* start = out;
+    float f[3][3] = {};
+    double n[3];
+    this->Facet(local, sample, f, n);
+    if (this->Binary)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        out = PutLittleEndian(out, static_cast<float>(n[k]));
+      }
+      for (int v = 0; v < 3; ++v)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          out = PutLittleEndian(out, f[v][k]);
+        }
+      }
+      out = PutLittleEndian(out, std::uint16_t(0));
+      return out - start;
+    }
+    char r[3][32];
+    auto reals = [&r](const double* values)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        if (FixedReal(r[k], values[k], false) != 15)
+        {
+          return false;
+        }
+      }
+      return true;
+    };
+    if (!reals(n))
+    {
+      return -1;
+    }
+    out += std::sprintf(out, "facet normal %s %s %s\n  outer loop\n", r[0], r[1], r[2]);
+    for (int v = 0; v < 3; ++v)
+    {
+      const double x[3] = { f[v][0], f[v][1], f[v][2] };
+      if (!reals(x))
+      {
+        return -1;
+      }
+      out += std::sprintf(out, "    vertex %s %s %s\n", r[0], r[1], r[2]);
+    }
+    out += std::sprintf(out, "  endloop\nendfacet\n");
+    return out - start;
+  }
+
+  // The corners of a facet, rounded to float as STL stores them, and the unit normal of those.
+  void Facet(const vtkIdType* local, bool sample, float f[3][3], double n[3]) const
+  {
+    for (int v = 0; v < 3 && !sample; ++v)
+    {
+      double x[3];
+      this->LocalMesh.Points->GetPoint(local[v], x);
+      for (int k = 0; k < 3; ++k)
+      {
+        f[v][k] = static_cast<float>(x[k]);
+      }
+    }
+    double a[3], b[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      a[k] = static_cast<double>(f[1][k]) - f[0][k];
+      b[k] = static_cast<double>(f[2][k]) - f[0][k];
+    }
+    n[0] = a[1] * b[2] - a[2] * b[1];
+    n[1] = a[2] * b[0] - a[0] * b[2];
+    n[2] = a[0] * b[1] - a[1] * b[0];
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int k = 0; k < 3 && length > 0; ++k)
+    {
+      n[k] /= length;
+    }
   }
 
   // VTP's offset of triangle `index`: where its connectivity ends.
@@ -737,10 +765,10 @@ private:
 
   Format Kind;
   bool Binary;
-  const Mesh& M;
+  const Mesh& LocalMesh; // this rank's part
   Int Vertices, Triangles, FirstTriangle;
   bool WithNormals, DoublePoints;
-  Layout L;
+  Layout FileLayout;
   Block PointBlock, NormalBlock, TriangleBlock, OffsetBlock;
   Int PointLength = 0, NormalLength = 0, TriangleLength = 0, OffsetLength = 0;
   int IdWidth = 1, OffsetWidth = 1;
@@ -793,17 +821,17 @@ vtkTypeBool vtkRGMergedSurfaceWriter::ProcessRequest(
 struct vtkRGMergedSurfaceWriter::Run
 {
   explicit Run(vtkMultiProcessController* controller)
-    : ranks(controller)
+    : Ranks(controller)
   {
   }
-  rgmc::Ranks ranks;
-  std::string problem;   // the agreed error of a failed pass
-  std::string name;      // the file's
-  std::string extension; // stl, ply, vtp or pvtp
-  vtkNew<vtkPolyData> surface;
-  Mesh mesh;
-  Int vertices = 0, triangles = 0, firstTriangle = 0; // over all ranks; this rank's first
-  bool normals = true;                                // every rank has them
+  rgmc::Ranks Ranks;
+  std::string Problem;   // the agreed error of a failed pass
+  std::string Name;      // the file's
+  std::string Extension; // stl, ply, vtp or pvtp
+  vtkNew<vtkPolyData> Surface;
+  Mesh LocalMesh;                                     // this rank's part
+  Int Vertices = 0, Triangles = 0, FirstTriangle = 0; // over all ranks; this rank's first
+  bool Normals = true;                                // every rank has them
 };
 
 //------------------------------------------------------------------------------
@@ -825,31 +853,31 @@ void vtkRGMergedSurfaceWriter::WriteData()
   // PASS 1: the file name and the format, agreed.
   if (!this->AgreeOnFile(run))
   {
-    this->Fail(run.problem);
+    this->Fail(run.Problem);
     return;
   }
   if (vtkPolyData* input = vtkPolyData::SafeDownCast(this->GetInput()))
   {
-    run.surface->ShallowCopy(input);
+    run.Surface->ShallowCopy(input);
   }
-  if (run.extension == "pvtp")
+  if (run.Extension == "pvtp")
   {
     if (!this->WritePieces(run))
     {
-      this->Fail(run.problem);
+      this->Fail(run.Problem);
     }
     return;
   }
   // PASS 2: the surface numbered as one mesh.
   if (!this->NumberSurface(run))
   {
-    this->Fail(run.problem);
+    this->Fail(run.Problem);
     return;
   }
   // PASS 3-4: one file, every rank writing its records.
   if (!this->WriteMerged(run))
   {
-    this->Fail(run.problem);
+    this->Fail(run.Problem);
   }
 }
 
@@ -863,19 +891,19 @@ void vtkRGMergedSurfaceWriter::Fail(const std::string& problem)
 //------------------------------------------------------------------------------
 bool vtkRGMergedSurfaceWriter::AgreeOnFile(Run& run)
 {
-  run.name = this->FileName ? this->FileName : "";
-  const std::size_t dot = run.name.find_last_of('.');
-  run.extension = dot == std::string::npos ? "" : run.name.substr(dot + 1);
-  const std::string& extension = run.extension;
-  if (run.name.empty())
+  run.Name = this->FileName ? this->FileName : "";
+  const std::size_t dot = run.Name.find_last_of('.');
+  run.Extension = dot == std::string::npos ? "" : run.Name.substr(dot + 1);
+  const std::string& extension = run.Extension;
+  if (run.Name.empty())
   {
-    run.problem = "no file name is set";
+    run.Problem = "no file name is set";
   }
   else if (extension != "stl" && extension != "ply" && extension != "vtp" && extension != "pvtp")
   {
-    run.problem = "the file name " + run.name + " must end in .stl, .ply, .vtp or .pvtp";
+    run.Problem = "the file name " + run.Name + " must end in .stl, .ply, .vtp or .pvtp";
   }
-  return run.ranks.Agree(run.problem.empty(), run.problem);
+  return run.Ranks.Agree(run.Problem.empty(), run.Problem);
 }
 
 //------------------------------------------------------------------------------
@@ -884,11 +912,11 @@ bool vtkRGMergedSurfaceWriter::WritePieces(Run& run)
 {
   vtkNew<vtkXMLPPolyDataWriter> pieces;
   ErrorCatcher catcher(pieces);
-  pieces->SetController(run.ranks.Controller());
-  pieces->SetNumberOfPieces(run.ranks.Size);
-  pieces->SetStartPiece(run.ranks.Rank);
-  pieces->SetEndPiece(run.ranks.Rank);
-  pieces->SetFileName(run.name.c_str());
+  pieces->SetController(run.Ranks.Controller());
+  pieces->SetNumberOfPieces(run.Ranks.Size);
+  pieces->SetStartPiece(run.Ranks.Rank);
+  pieces->SetEndPiece(run.Ranks.Rank);
+  pieces->SetFileName(run.Name.c_str());
   if (this->FileType == VTK_ASCII)
   {
     pieces->SetDataModeToAscii();
@@ -897,10 +925,10 @@ bool vtkRGMergedSurfaceWriter::WritePieces(Run& run)
   {
     pieces->SetDataModeToBinary(); // inline: appended data does not load on Debian 12
   }
-  pieces->SetInputData(run.surface);
+  pieces->SetInputData(run.Surface);
   const bool ok = pieces->Write() != 0 && pieces->GetErrorCode() == 0;
-  run.problem = catcher.Message.empty() ? "could not write " + run.name : catcher.Message;
-  return run.ranks.Agree(ok, run.problem);
+  run.Problem = catcher.Message.empty() ? "could not write " + run.Name : catcher.Message;
+  return run.Ranks.Agree(ok, run.Problem);
 }
 
 //------------------------------------------------------------------------------
@@ -909,60 +937,60 @@ bool vtkRGMergedSurfaceWriter::WritePieces(Run& run)
 // this rank's first triangle.
 bool vtkRGMergedSurfaceWriter::NumberSurface(Run& run)
 {
-  rgmc::Ranks& ranks = run.ranks;
+  rgmc::Ranks& ranks = run.Ranks;
   for (int attempt = 0;; ++attempt)
   {
-    const Collected collected = Collect(run.surface, run.mesh);
-    run.problem = "out of memory while collecting this rank's vertices and triangles";
-    if (!ranks.Agree(collected != Collected::OutOfMemory, run.problem))
+    const Collected collected = Collect(run.Surface, run.LocalMesh);
+    run.Problem = "out of memory while collecting this rank's vertices and triangles";
+    if (!ranks.Agree(collected != Collected::OutOfMemory, run.Problem))
     {
       return false;
     }
-    Int local[3] = { static_cast<Int>(run.mesh.Owned.size()),
-      static_cast<Int>(run.mesh.Triangles.size() / 3),
-      run.surface->GetNumberOfPoints() > 0 && !run.mesh.Normals ? 1 : 0 };
+    Int local[3] = { static_cast<Int>(run.LocalMesh.Owned.size()),
+      static_cast<Int>(run.LocalMesh.Triangles.size() / 3),
+      run.Surface->GetNumberOfPoints() > 0 && !run.LocalMesh.Normals ? 1 : 0 };
     std::vector<Int> all(3 * static_cast<std::size_t>(ranks.Size));
     ranks.AllGather(local, all.data(), 3, "exchanging the counts");
-    if (!ranks.Agree(true, run.problem))
+    if (!ranks.Agree(true, run.Problem))
     {
       return false;
     }
-    run.vertices = run.triangles = run.firstTriangle = 0;
-    run.normals = true;
+    run.Vertices = run.Triangles = run.FirstTriangle = 0;
+    run.Normals = true;
     for (int r = 0; r < ranks.Size; ++r)
     {
       if (r == ranks.Rank)
       {
-        run.firstTriangle = run.triangles;
+        run.FirstTriangle = run.Triangles;
       }
-      run.vertices += all[3 * r];
-      run.triangles += all[3 * r + 1];
-      run.normals = run.normals && all[3 * r + 2] == 0;
+      run.Vertices += all[3 * r];
+      run.Triangles += all[3 * r + 1];
+      run.Normals = run.Normals && all[3 * r + 2] == 0;
     }
-    const bool ready = collected == Collected::Numbered && Placeable(run.mesh, run.vertices);
+    const bool ready = collected == Collected::Numbered && Placeable(run.LocalMesh, run.Vertices);
     if (!ranks.Any(!ready))
     {
       return true;
     }
     if (attempt > 0)
     {
-      run.problem = "Seam Repair's numbering of the surface is not contiguous";
+      run.Problem = "Seam Repair's numbering of the surface is not contiguous";
       return false;
     }
     vtkNew<vtkRGSeamRepair> numbering;
     ErrorCatcher catcher(numbering);
     numbering->SetController(ranks.Controller());
     numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
-    numbering->SetInputData(run.surface);
+    numbering->SetInputData(run.Surface);
     numbering->Update(); // collective; it agrees its errors over the ranks itself
-    run.problem = "it cannot be numbered as one mesh: " + catcher.Message;
-    if (!ranks.Agree(catcher.Message.empty(), run.problem))
+    run.Problem = "it cannot be numbered as one mesh: " + catcher.Message;
+    if (!ranks.Agree(catcher.Message.empty(), run.Problem))
     {
       return false;
     }
     auto numbered = vtkSmartPointer<vtkPolyData>::New();
     numbered->ShallowCopy(numbering->GetOutput());
-    run.surface->ShallowCopy(numbered);
+    run.Surface->ShallowCopy(numbered);
   }
 }
 
@@ -971,18 +999,18 @@ bool vtkRGMergedSurfaceWriter::NumberSurface(Run& run)
 // rank 0 also the texts. A file that failed on some rank is incomplete: it is removed.
 bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
 {
-  rgmc::Ranks& ranks = run.ranks;
-  const std::string& extension = run.extension;
-  const bool normals = run.normals && extension != "stl" && run.vertices > 0;
+  rgmc::Ranks& ranks = run.Ranks;
+  const std::string& extension = run.Extension;
+  const bool normals = run.Normals && extension != "stl" && run.Vertices > 0;
   const Format format =
     extension == "stl" ? Format::STL : (extension == "ply" ? Format::PLY : Format::VTP);
   // The points' type is in the header: double when any rank has double points.
-  const bool doublePoints = ranks.Any(
-    format != Format::STL && run.mesh.Points && run.mesh.Points->GetDataType() == VTK_DOUBLE);
-  MergedFile file(format, this->FileType != VTK_ASCII, run.mesh, run.vertices, run.triangles,
-    run.firstTriangle, normals, doublePoints);
-  run.problem = file.Limit();
-  if (!run.problem.empty())
+  const bool doublePoints = ranks.Any(format != Format::STL && run.LocalMesh.Points &&
+    run.LocalMesh.Points->GetDataType() == VTK_DOUBLE);
+  MergedFile file(format, this->FileType != VTK_ASCII, run.LocalMesh, run.Vertices, run.Triangles,
+    run.FirstTriangle, normals, doublePoints);
+  run.Problem = file.Limit();
+  if (!run.Problem.empty())
   {
     return false; // the same on every rank: the counts are global
   }
@@ -990,33 +1018,33 @@ bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
 
   // PASS 3: rank 0 creates the file, then every other rank opens it.
   RangeFile out;
-  bool ok = ranks.Rank != 0 || out.Open(run.name, true);
+  bool ok = ranks.Rank != 0 || out.Open(run.Name, true);
   if (!ranks.Agree(ok, out.Problem))
   {
-    run.problem = out.Problem;
+    run.Problem = out.Problem;
     return false;
   }
-  ok = ranks.Rank == 0 || out.Open(run.name, false);
-  run.problem = out.Problem;
-  if (ranks.Agree(ok, run.problem))
+  ok = ranks.Rank == 0 || out.Open(run.Name, false);
+  run.Problem = out.Problem;
+  if (ranks.Agree(ok, run.Problem))
   {
     // PASS 4: every rank writes its records; rank 0 also the texts.
     bool written = false;
     try
     {
       written = file.Write(out, ranks.Rank == 0);
-      run.problem = file.Problem;
+      run.Problem = file.Problem;
     }
     catch (const std::bad_alloc&)
     {
-      run.problem = "out of memory while writing " + run.name;
+      run.Problem = "out of memory while writing " + run.Name;
     }
     ok = out.Close() && written;
     if (!out.Problem.empty())
     {
-      run.problem = out.Problem;
+      run.Problem = out.Problem;
     }
-    if (ranks.Agree(ok, run.problem))
+    if (ranks.Agree(ok, run.Problem))
     {
       return true;
     }
@@ -1024,7 +1052,7 @@ bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
   out.Close();
   if (ranks.Rank == 0)
   {
-    ::unlink(run.name.c_str());
+    ::unlink(run.Name.c_str());
   }
   return false;
 }

@@ -89,7 +89,7 @@ void SwapBytes(char* data, int size)
 /// The header fields the reader uses, in host byte order.
 struct Header
 {
-  bool Swap = false;
+  bool ByteSwapped = false; // the file's byte order is not this host's
   std::int16_t Dim[8] = {};
   std::int16_t DataType = 0, BitPix = 0, QFormCode = 0, SFormCode = 0;
   float PixDim[8] = {}, VoxOffset = 0, SclSlope = 0, SclInter = 0;
@@ -126,7 +126,7 @@ bool ParseHeader(const char* raw, Header& h, std::string& problem)
     problem = "is not a NIfTI-1 file (its header size is " + std::to_string(size) + ", not 348)";
     return false;
   }
-  h.Swap = size != HeaderSize;
+  h.ByteSwapped = size != HeaderSize;
   std::memcpy(h.Magic, raw + 344, 4);
   if (std::memcmp(h.Magic, "ni1", 4) == 0)
   {
@@ -140,23 +140,23 @@ bool ParseHeader(const char* raw, Header& h, std::string& problem)
   }
   for (int d = 0; d < 8; ++d)
   {
-    h.Dim[d] = Field<std::int16_t>(raw, 40 + 2 * d, h.Swap);
-    h.PixDim[d] = Field<float>(raw, 76 + 4 * d, h.Swap);
+    h.Dim[d] = Field<std::int16_t>(raw, 40 + 2 * d, h.ByteSwapped);
+    h.PixDim[d] = Field<float>(raw, 76 + 4 * d, h.ByteSwapped);
   }
-  h.DataType = Field<std::int16_t>(raw, 70, h.Swap);
-  h.BitPix = Field<std::int16_t>(raw, 72, h.Swap);
-  h.VoxOffset = Field<float>(raw, 108, h.Swap);
-  h.SclSlope = Field<float>(raw, 112, h.Swap);
-  h.SclInter = Field<float>(raw, 116, h.Swap);
-  h.QFormCode = Field<std::int16_t>(raw, 252, h.Swap);
-  h.SFormCode = Field<std::int16_t>(raw, 254, h.Swap);
+  h.DataType = Field<std::int16_t>(raw, 70, h.ByteSwapped);
+  h.BitPix = Field<std::int16_t>(raw, 72, h.ByteSwapped);
+  h.VoxOffset = Field<float>(raw, 108, h.ByteSwapped);
+  h.SclSlope = Field<float>(raw, 112, h.ByteSwapped);
+  h.SclInter = Field<float>(raw, 116, h.ByteSwapped);
+  h.QFormCode = Field<std::int16_t>(raw, 252, h.ByteSwapped);
+  h.SFormCode = Field<std::int16_t>(raw, 254, h.ByteSwapped);
   for (int a = 0; a < 3; ++a)
   {
-    h.Quatern[a] = Field<float>(raw, 256 + 4 * a, h.Swap);
-    h.QOffset[a] = Field<float>(raw, 268 + 4 * a, h.Swap);
+    h.Quatern[a] = Field<float>(raw, 256 + 4 * a, h.ByteSwapped);
+    h.QOffset[a] = Field<float>(raw, 268 + 4 * a, h.ByteSwapped);
     for (int c = 0; c < 4; ++c)
     {
-      h.SRow[a][c] = Field<float>(raw, 280 + 16 * a + 4 * c, h.Swap);
+      h.SRow[a][c] = Field<float>(raw, 280 + 16 * a + 4 * c, h.ByteSwapped);
     }
   }
   return true;
@@ -669,7 +669,7 @@ bool vtkRGNIfTIReader::Scan(std::vector<vtkIdType>& header, std::string& message
   header.clear();
   rgmc::MessageWriter p(header);
   PackGeometry(p, scan.Dimensions, scan.Spacing, scan.Origin, scan.Direction, type);
-  p.Int(scan.StoredType).Int(scan.BytesPerVoxel).Int(scan.Fields.Swap ? 1 : 0);
+  p.Int(scan.StoredType).Int(scan.BytesPerVoxel).Int(scan.Fields.ByteSwapped ? 1 : 0);
   p.Real(scan.Fields.VoxOffset);
   p.Real(scan.Slope).Real(scan.Intercept).Int(scan.GeometryMethod);
   p.Text(scan.Warnings.str()).Text(Summarize(scan));
@@ -683,7 +683,7 @@ bool vtkRGNIfTIReader::Parse(const std::vector<vtkIdType>& header, std::string& 
   this->UnpackGeometry(u);
   this->DataType = static_cast<int>(u.Int());
   this->BytesPerVoxel = static_cast<int>(u.Int());
-  this->Swap = u.Int() != 0;
+  this->ByteSwapped = u.Int() != 0;
   this->VoxelOffset = u.Real();
   this->RescaleSlope = u.Real();
   this->RescaleIntercept = u.Real();
@@ -744,7 +744,7 @@ bool vtkRGNIfTIReader::ReadExtent(const int extent[6], vtkDataArray* scalars, st
       for (int i = 0; i < width; ++i)
       {
         values[i] = this->RescaleSlope *
-            Voxel(row + static_cast<std::size_t>(i) * bytes, this->DataType, this->Swap) +
+            Voxel(row + static_cast<std::size_t>(i) * bytes, this->DataType, this->ByteSwapped) +
           this->RescaleIntercept;
       }
       Store(scalars, at, values.data(), values.size());
@@ -764,5 +764,5 @@ void vtkRGNIfTIReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "VoxelOffset: " << this->VoxelOffset << "\n";
   os << indent << "DataType: " << this->DataType << "\n";
   os << indent << "BytesPerVoxel: " << this->BytesPerVoxel << "\n";
-  os << indent << "Swap: " << this->Swap << "\n";
+  os << indent << "ByteSwapped: " << this->ByteSwapped << "\n";
 }

@@ -67,7 +67,7 @@ protected:
   double VoxelOffset = 0;
   int DataType = 0;
   int BytesPerVoxel = 0;
-  bool Swap = false;
+  bool ByteSwapped = false;
 
 private:
   vtkRGNIfTIReader(const vtkRGNIfTIReader&) = delete;
