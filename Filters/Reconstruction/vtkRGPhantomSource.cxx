@@ -83,40 +83,10 @@ double Noise(std::uint64_t index, int seed)
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * Pi * u2);
 }
 
-} // namespace
-
-//------------------------------------------------------------------------------
-vtkRGPhantomSource::vtkRGPhantomSource()
+/// Brain and ventricles inside the cranium (`inner`: the distance to its inner surface); eyes
+/// in front of the orbits.
+void AddBrainAndEyes(const double p[3], double inner, double ramp, double& v)
 {
-  this->SetNumberOfInputPorts(0);
-}
-
-double vtkRGPhantomSource::Spacing() const
-{
-  const int longest = std::max(this->Dimensions[0], std::max(this->Dimensions[1], this->Dimensions[2]));
-  return this->FieldOfView / std::max(1, longest);
-}
-
-double vtkRGPhantomSource::Ramp() const
-{
-  return std::max(1.2, 1.5 * this->Spacing());
-}
-
-//------------------------------------------------------------------------------
-double vtkRGPhantomSource::Evaluate(const double p[3]) const
-{
-  const double ramp = this->Ramp();
-  double v = -1000.0; // air
-
-  const double head = EllipsoidSd(p, HeadC, HeadR);
-  if (head > ramp)
-  {
-    return v;
-  }
-  Mix(v, 40.0, Inside(head, ramp));
-
-  // Brain and ventricles inside the cranium; eyes in front of the orbits.
-  const double inner = EllipsoidSd(p, SkullC, SkullInner);
   if (inner < ramp)
   {
     Mix(v, 35.0, Inside(inner, ramp));
@@ -132,8 +102,11 @@ double vtkRGPhantomSource::Evaluate(const double p[3]) const
     const double r[3] = { EyeR, EyeR, EyeR };
     Mix(v, 15.0, Inside(EllipsoidSd(p, c, r), ramp));
   }
+}
 
-  // The cranium: a shell with holes, its density varying as cortical bone does.
+/// The cranium: a shell with holes, its density varying as cortical bone does.
+void AddCranium(const double p[3], double inner, double ramp, double& v)
+{
   const double outer = EllipsoidSd(p, SkullC, SkullOuter);
   if (outer < ramp)
   {
@@ -151,8 +124,12 @@ double vtkRGPhantomSource::Evaluate(const double p[3]) const
       150 * std::sin(0.06 * p[2]);
     Mix(v, hu, Inside(sd, ramp));
   }
+}
 
-  // Separate bones below the cranium. Mandible: the front half of a torus.
+/// Separate bones below the cranium: the mandible, three vertebrae and a small fragment.
+void AddLowerBones(const double p[3], double ramp, double& v)
+{
+  // Mandible: the front half of a torus.
   {
     const double c[3] = { 0, 25, -75 };
     const double ring = std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]));
@@ -182,6 +159,44 @@ double vtkRGPhantomSource::Evaluate(const double p[3]) const
       Mix(v, 1000.0, Inside(sd, ramp));
     }
   }
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkRGPhantomSource::vtkRGPhantomSource()
+{
+  this->SetNumberOfInputPorts(0);
+}
+
+double vtkRGPhantomSource::Spacing() const
+{
+  const int longest =
+    std::max(this->Dimensions[0], std::max(this->Dimensions[1], this->Dimensions[2]));
+  return this->FieldOfView / std::max(1, longest);
+}
+
+double vtkRGPhantomSource::Ramp() const
+{
+  return std::max(1.2, 1.5 * this->Spacing());
+}
+
+//------------------------------------------------------------------------------
+double vtkRGPhantomSource::Evaluate(const double p[3]) const
+{
+  const double ramp = this->Ramp();
+  double v = -1000.0; // air
+
+  const double head = EllipsoidSd(p, HeadC, HeadR);
+  if (head > ramp)
+  {
+    return v;
+  }
+  Mix(v, 40.0, Inside(head, ramp));
+  const double inner = EllipsoidSd(p, SkullC, SkullInner);
+  AddBrainAndEyes(p, inner, ramp, v);
+  AddCranium(p, inner, ramp, v);
+  AddLowerBones(p, ramp, v);
   return v;
 }
 
@@ -194,9 +209,8 @@ int vtkRGPhantomSource::RequestInformation(
   {
     if (this->Dimensions[a] < 2)
     {
-      vtkErrorMacro(<< "Dimensions must be at least 2 along each axis, not "
-                    << this->Dimensions[0] << " x " << this->Dimensions[1] << " x "
-                    << this->Dimensions[2] << ".");
+      vtkErrorMacro(<< "Dimensions must be at least 2 along each axis, not " << this->Dimensions[0]
+                    << " x " << this->Dimensions[1] << " x " << this->Dimensions[2] << ".");
       return 0;
     }
   }

@@ -79,9 +79,8 @@ inline void* AllocateHugePages(std::size_t bytes, std::size_t& rounded)
 }
 
 /// std::allocator for large arrays (Seam Repair's per-vertex and per-triangle arrays): those of
-/// 4 MiB or more in whole huge pages (AllocateHugePages). Measured on Seam Repair of the 512^3
-/// skull: 0.63 -> 0.54-0.59 s on one thread; peak +7 MiB on a 6.7 M-triangle surface
-/// (docs/evaluation.md).
+/// 4 MiB or more in whole huge pages (AllocateHugePages), which fault in far fewer times than
+/// 4 KiB pages for a few MiB more at the peak (docs/evaluation.md, Memory).
 template <typename T>
 struct LargeArrayAllocator
 {

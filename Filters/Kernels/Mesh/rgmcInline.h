@@ -1,7 +1,6 @@
 // RGMC_INLINE: for the small functions on the kernel's hot paths (reading a cube, a vertex's
 // key, a cube's found-bit), which sit in several layers of templates and must not become calls:
-// measured, letting the compiler decide made seeded extraction 1.5x slower than the same code
-// in one class.
+// left to itself the compiler makes some of them calls, and a call costs as much as the step.
 #ifndef rgmcInline_h
 #define rgmcInline_h
 

@@ -148,13 +148,13 @@ struct Face
 /// inside and goes on along the sides (Arrival), or leaves the sides into the face.
 struct Event
 {
-  double T;
-  int Kind; // -1 arrival, +1 departure
+  double Along; // where on the face's perimeter (Face::At)
+  int Kind;     // -1 arrival, +1 departure
   std::int64_t Gid;
   double UV[2];
   bool operator<(const Event& o) const
   {
-    return std::tie(this->T, this->Kind, this->Gid) < std::tie(o.T, o.Kind, o.Gid);
+    return std::tie(this->Along, this->Kind, this->Gid) < std::tie(o.Along, o.Kind, o.Gid);
   }
 };
 
@@ -180,11 +180,9 @@ bool CoveredAt(const FaceCap& cap, double t, double perimeter)
   return false;
 }
 
-} // namespace
-
-Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
+/// The mesh's boundary edges among `edges` (sorted in place): those no other triangle has.
+std::vector<BorderEdge> BoundaryEdges(std::vector<BorderEdge>& edges)
 {
-  // The mesh's boundary edges among them: those no other triangle has.
   auto key = [](const BorderEdge& e)
   { return std::make_tuple(std::min(e.From, e.To), std::max(e.From, e.To), e.From); };
   std::sort(edges.begin(), edges.end(),
@@ -205,139 +203,166 @@ Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
     }
     i = j;
   }
+  return boundary;
+}
 
+/// Where the outline of the cap on `face` meets the face's sides: the ends of the boundary
+/// edges' chains in the face, arrivals and departures, unsorted. Adds the edges' own loop area
+/// to `cap`; an outline that ends inside the face opens `caps`.
+std::vector<Event> OutlineEvents(
+  const std::vector<BorderEdge>& boundary, const Face& face, FaceCap& cap, Caps& caps)
+{
+  // The cap's outline runs the mesh's boundary edges backwards.
+  std::map<std::int64_t, std::pair<int, const BorderEdge*>> net; // gid: out - in
+  for (const BorderEdge& e : boundary)
+  {
+    if (!(e.FromFaces & e.ToFaces & face.Bit))
+    {
+      continue;
+    }
+    const double p[2] = { e.ToIndex[face.U], e.ToIndex[face.V] };
+    const double q[2] = { e.FromIndex[face.U], e.FromIndex[face.V] };
+    cap.TwiceLoopArea += face.Cross(p, q);
+    auto& out = net[e.To];
+    out.first += 1;
+    out.second = &e;
+    auto& in = net[e.From];
+    in.first -= 1;
+    in.second = &e;
+  }
+  std::vector<Event> events;
+  for (const auto& entry : net)
+  {
+    if (entry.second.first == 0)
+    {
+      continue;
+    }
+    const BorderEdge& e = *entry.second.second;
+    const bool to = e.To == entry.first;
+    const int faceBits = to ? e.ToFaces : e.FromFaces;
+    const double* x = to ? e.ToIndex : e.FromIndex;
+    const double uv[2] = { x[face.U], x[face.V] };
+    int side = 0;
+    while (side < 4 && !(faceBits & face.SideBits[side]))
+    {
+      ++side;
+    }
+    if (side == 4)
+    {
+      caps.Closed = false; // an outline that ends inside the face: the surface has a hole
+      continue;
+    }
+    const int kind = entry.second.first > 0 ? 1 : -1;
+    for (int n = 0; n < std::abs(entry.second.first); ++n)
+    {
+      events.push_back(Event{ face.At(side, uv), kind, entry.first, { uv[0], uv[1] } });
+    }
+  }
+  return events;
+}
+
+/// Closes the cap on `face` along its sides, from each arrival to the departure after it
+/// (counterclockwise, through the corners between): its area and the stretches it covers.
+/// An arrival not followed by a departure opens `caps`.
+void CloseAlongSides(std::vector<Event>& events, const Face& face, FaceCap& cap, Caps& caps)
+{
+  cap.HasEvents = true;
+  std::sort(events.begin(), events.end());
+  double twice = cap.TwiceLoopArea;
+  const double perimeter = face.Perimeter();
+  for (std::size_t i = 0; i < events.size(); ++i)
+  {
+    if (events[i].Kind != -1)
+    {
+      continue;
+    }
+    const Event& from = events[i];
+    const Event& to = events[(i + 1) % events.size()];
+    if (to.Kind != 1)
+    {
+      caps.Closed = false;
+      continue;
+    }
+    double end = to.Along;
+    if (end < from.Along || (end == from.Along && (i + 1) % events.size() <= i))
+    {
+      end += perimeter;
+    }
+    double last[2] = { from.UV[0], from.UV[1] };
+    for (int lap = 0; lap < 2; ++lap)
+    {
+      for (int side = 0; side < 4; ++side)
+      {
+        const double t = face.SideStart(side) + lap * perimeter;
+        if (t > from.Along && t < end)
+        {
+          double corner[2];
+          face.Corner(side, corner);
+          twice += face.Cross(last, corner);
+          std::copy_n(corner, 2, last);
+        }
+      }
+    }
+    twice += face.Cross(last, to.UV);
+    cap.Covered.emplace_back(from.Along, to.Along);
+  }
+  cap.TwiceArea = twice;
+}
+
+/// The cap of face f, whose sides the outline never meets: all in or all out, as the
+/// neighbouring faces' caps say along the shared side, else as the outline's own loops say
+/// (holes: in).
+void FillWholeFace(int f, FaceCap (&faces)[6], const VolumeBox& box)
+{
+  FaceCap& cap = faces[f];
+  const Face face(f, box);
+  int inside = -1;
+  for (int g = 0; g < 6 && inside < 0; ++g)
+  {
+    if (!faces[g].HasEvents || g / 2 == f / 2)
+    {
+      continue;
+    }
+    const Face other(g, box);
+    for (int side = 0; side < 4; ++side)
+    {
+      if (other.SideBits[side] == face.Bit)
+      {
+        const double middle =
+          other.SideStart(side) + 0.5 * (side % 2 ? other.Height() : other.Width());
+        inside = CoveredAt(faces[g], middle, other.Perimeter()) ? 1 : 0;
+      }
+    }
+  }
+  if (inside < 0)
+  {
+    inside = cap.TwiceLoopArea < 0 ? 1 : 0;
+  }
+  cap.TwiceArea = cap.TwiceLoopArea + (inside ? 2.0 * face.Width() * face.Height() : 0.0);
+}
+
+} // namespace
+
+Caps BorderCaps(std::vector<BorderEdge> edges, const VolumeBox& box)
+{
+  const std::vector<BorderEdge> boundary = BoundaryEdges(edges);
   Caps caps;
   FaceCap faces[6];
   for (int f = 0; f < 6; ++f)
   {
     const Face face(f, box);
-    FaceCap& cap = faces[f];
-    // The cap's outline runs the mesh's boundary edges backwards.
-    std::map<std::int64_t, std::pair<int, const BorderEdge*>> net; // gid: out - in
-    for (const BorderEdge& e : boundary)
+    std::vector<Event> events = OutlineEvents(boundary, face, faces[f], caps);
+    if (!events.empty())
     {
-      if (!(e.FromFaces & e.ToFaces & face.Bit))
-      {
-        continue;
-      }
-      const double p[2] = { e.ToIndex[face.U], e.ToIndex[face.V] };
-      const double q[2] = { e.FromIndex[face.U], e.FromIndex[face.V] };
-      cap.TwiceLoopArea += face.Cross(p, q);
-      auto& out = net[e.To];
-      out.first += 1;
-      out.second = &e;
-      auto& in = net[e.From];
-      in.first -= 1;
-      in.second = &e;
+      CloseAlongSides(events, face, faces[f], caps);
     }
-    std::vector<Event> events;
-    for (const auto& entry : net)
-    {
-      if (entry.second.first == 0)
-      {
-        continue;
-      }
-      const BorderEdge& e = *entry.second.second;
-      const bool to = e.To == entry.first;
-      const int faceBits = to ? e.ToFaces : e.FromFaces;
-      const double* x = to ? e.ToIndex : e.FromIndex;
-      const double uv[2] = { x[face.U], x[face.V] };
-      int side = 0;
-      while (side < 4 && !(faceBits & face.SideBits[side]))
-      {
-        ++side;
-      }
-      if (side == 4)
-      {
-        caps.Closed = false; // an outline that ends inside the face: the surface has a hole
-        continue;
-      }
-      const int kind = entry.second.first > 0 ? 1 : -1;
-      for (int n = 0; n < std::abs(entry.second.first); ++n)
-      {
-        events.push_back(Event{ face.At(side, uv), kind, entry.first, { uv[0], uv[1] } });
-      }
-    }
-    if (events.empty())
-    {
-      continue;
-    }
-    cap.HasEvents = true;
-    std::sort(events.begin(), events.end());
-    double twice = cap.TwiceLoopArea;
-    const double perimeter = face.Perimeter();
-    for (std::size_t i = 0; i < events.size(); ++i)
-    {
-      if (events[i].Kind != -1)
-      {
-        continue;
-      }
-      const Event& from = events[i];
-      const Event& to = events[(i + 1) % events.size()];
-      if (to.Kind != 1)
-      {
-        caps.Closed = false;
-        continue;
-      }
-      // Along the sides from `from` to `to`, counterclockwise, through the corners between.
-      double end = to.T;
-      if (end < from.T || (end == from.T && (i + 1) % events.size() <= i))
-      {
-        end += perimeter;
-      }
-      double last[2] = { from.UV[0], from.UV[1] };
-      for (int lap = 0; lap < 2; ++lap)
-      {
-        for (int side = 0; side < 4; ++side)
-        {
-          const double t = face.SideStart(side) + lap * perimeter;
-          if (t > from.T && t < end)
-          {
-            double corner[2];
-            face.Corner(side, corner);
-            twice += face.Cross(last, corner);
-            std::copy_n(corner, 2, last);
-          }
-        }
-      }
-      twice += face.Cross(last, to.UV);
-      cap.Covered.emplace_back(from.T, to.T);
-    }
-    cap.TwiceArea = twice;
   }
-  // Faces whose sides the outline never meets: all in or all out, as the neighbouring faces'
-  // caps say along the shared side, else as the outline's own loops say (holes: in).
   for (int f = 0; f < 6; ++f)
   {
-    FaceCap& cap = faces[f];
-    if (cap.HasEvents)
+    if (!faces[f].HasEvents)
     {
-      continue;
+      FillWholeFace(f, faces, box);
     }
-    const Face face(f, box);
-    int inside = -1;
-    for (int g = 0; g < 6 && inside < 0; ++g)
-    {
-      if (!faces[g].HasEvents || g / 2 == f / 2)
-      {
-        continue;
-      }
-      const Face other(g, box);
-      for (int side = 0; side < 4; ++side)
-      {
-        if (other.SideBits[side] == face.Bit)
-        {
-          const double middle =
-            other.SideStart(side) + 0.5 * (side % 2 ? other.Height() : other.Width());
-          inside = CoveredAt(faces[g], middle, other.Perimeter()) ? 1 : 0;
-        }
-      }
-    }
-    if (inside < 0)
-    {
-      inside = cap.TwiceLoopArea < 0 ? 1 : 0;
-    }
-    cap.TwiceArea = cap.TwiceLoopArea + (inside ? 2.0 * face.Width() * face.Height() : 0.0);
   }
   for (int f = 0; f < 6; ++f)
   {

@@ -7,8 +7,8 @@
 #define rgmcExtraction_h
 
 #include "rgmcBuffer.h"
-#include "rgmcCubeSurface.h"
 #include "rgmcKeyMap.h"
+#include "rgmcSampledVolume.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -649,35 +649,36 @@ private:
         constexpr int B = SampledVolume<Values>::VertexBatch;
         struct Batch
         {
-          int P[B][3];
+          int Points[B][3];
           int Axis[B];
           std::int64_t To[B];
-          int N = 0;
+          int Count = 0;
         } batches[2];
         std::int64_t next = 0;
         auto fill = [&](Batch& b)
         {
-          b.N = 0;
-          for (; next < nv && b.N < B; ++next)
+          b.Count = 0;
+          for (; next < nv && b.Count < B; ++next)
           {
             const std::int64_t to = chunk.FinalId[next];
             if (to < base)
             {
               continue; // the chunk below's vertex
             }
-            this->Volume.GridOf.Decode(from.Keys[next], b.P[b.N], b.Axis[b.N]);
-            this->Volume.PrefetchAround(b.P[b.N][0], b.P[b.N][1], b.P[b.N][2]);
-            b.To[b.N++] = to;
+            this->Volume.GridOf.Decode(from.Keys[next], b.Points[b.Count], b.Axis[b.Count]);
+            this->Volume.PrefetchAround(
+              b.Points[b.Count][0], b.Points[b.Count][1], b.Points[b.Count][2]);
+            b.To[b.Count++] = to;
             m.Keys[to] = from.Keys[next];
             m.VertexComponent[to] = from.VertexComponent[next];
           }
         };
         fill(batches[0]);
-        for (int current = 0; batches[current].N > 0; current = 1 - current)
+        for (int current = 0; batches[current].Count > 0; current = 1 - current)
         {
           fill(batches[1 - current]);
-          this->PlaceVertices(batches[current].P, batches[current].Axis, batches[current].To,
-            batches[current].N, doublePoints, normals);
+          this->PlaceVertices(batches[current].Points, batches[current].Axis, batches[current].To,
+            batches[current].Count, doublePoints, normals);
         }
         const std::int64_t t0 = triangleBase[c];
         for (std::int64_t t = 0; t < from.NumberOfTriangles(); ++t)

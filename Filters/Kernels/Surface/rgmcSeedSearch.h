@@ -4,7 +4,7 @@
 #ifndef rgmcSeedSearch_h
 #define rgmcSeedSearch_h
 
-#include "rgmcCubeSurface.h"
+#include "rgmcSampledVolume.h"
 
 #include <algorithm>
 #include <cmath>

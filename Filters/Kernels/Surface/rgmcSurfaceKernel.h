@@ -5,8 +5,11 @@
 // Layers, each file including only those below it:
 //   rgmcSurfaceKernel.h   this file: the kernel's interface (Kernel), and the three passes over
 //                         one piece behind it (SurfaceKernel)
-//   rgmcSeedSearch.h, rgmcGrowth.h, rgmcExtraction.h
-//   rgmcCubeSurface.h     samples, vertex geometry, a cube's surface nodes, components
+//   rgmcSeedSearch.h, rgmcGrowth.h (growth's scheduler: tiles, rounds, threads),
+//   rgmcExtraction.h
+//   rgmcNodeVisits.h      growth's per-node step of the breadth-first search
+//   rgmcSampledVolume.h   one piece's samples, the passes' shared state, vertex geometry
+//   rgmcCubeSurface.h     options, a cube's surface nodes, the cubes around a vertex, components
 //   rgmcCaseTable.h, rgmcGrid.h, rgmcUnionFind.h, rgmcKeyMap.h, rgmcBuffer.h
 #ifndef rgmcSurfaceKernel_h
 #define rgmcSurfaceKernel_h
