@@ -77,8 +77,10 @@
 #include "RGMCReconstructionModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
-#include <string> // For DescribeInputProblem
-#include <vector> // For the seed points
+#include <cstdint> // For the vertex keys of the passes
+#include <string>  // For DescribeInputProblem
+#include <utility> // For the vertices received between ranks
+#include <vector>  // For the seed points
 
 class vtkImageData;
 class vtkMultiProcessController;
@@ -238,12 +240,26 @@ private:
   void BuildKernel(Run& run);
   /// 1: every seed has a vertex; 0: no surface near a seed (warned); -1: an error.
   int FindSeeds(Run& run);
+  std::string DescribeSeedOutsideVolume(Run& run, std::vector<double>& seedIndex);
+  bool GatherNearestVertices(
+    Run& run, const std::vector<double>& seedIndex, std::vector<vtkIdType>& all);
+  void WarnNoSurfaceNearSeed(Run& run, int seed);
   /// 1: done; 0: aborted; -1: an error.
   int GrowAndExtract(Run& run);
   /// Seeded growth on several ranks, in rounds; false on an error (in the run).
   bool GrowInRounds(Run& run, bool& aborted);
+  void AddressDepartures(Run& run, const std::vector<std::pair<std::int64_t, int>>& received,
+    std::vector<std::vector<vtkIdType>>& outgoing, bool& sending);
+  void GrowFromNeighbours(Run& run, const std::vector<std::vector<vtkIdType>>& incoming,
+    std::vector<std::pair<std::int64_t, int>>& received);
+  void GrowComponentsAtSharedFaces(Run& run, std::string& problem);
+  void GrowAndExtractLocally(Run& run, bool rounds, bool aborted);
+  void JoinComponentsAtPorts(Run& run, bool aborted);
+  /// 1: go on; 0: aborted; -1: an error.
+  int AgreeOnGraphSizes(Run& run, bool aborted);
   void Account(Run& run);
   bool StoreSurface(Run& run, vtkPolyData* output);
+  void AdoptSurface(Run& run, vtkPolyData* output);
   void DescribeSurface(Run& run, vtkPolyData* output);
 };
 
