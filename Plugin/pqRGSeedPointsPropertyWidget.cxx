@@ -1,6 +1,7 @@
 // The seed list of Region-Growing Marching Cubes in the properties panel, with a handle in the
 // render view that places seeds (P: on the surface under the mouse, Ctrl+P: nearest point).
 #include "pqRGSeedPointsPropertyWidget.h"
+#include "ui_pqRGSeedPointsPropertyWidget.h"
 
 #include "pqApplicationCore.h"
 #include "pqCoreUtilities.h"
@@ -22,32 +23,62 @@
 #include "vtkSMSessionProxyManager.h"
 
 #include <QCheckBox>
-#include <QGridLayout>
-#include <QHBoxLayout>
 #include <QHeaderView>
-#include <QLabel>
 #include <QPushButton>
 #include <QTableWidget>
-#include <QVBoxLayout>
 
 #include <algorithm>
 #include <set>
-
-namespace
-{
-const char* const AxisNames[3] = { "X", "Y", "Z" };
-}
 
 //-----------------------------------------------------------------------------
 pqRGSeedPointsPropertyWidget::pqRGSeedPointsPropertyWidget(
   vtkSMProxy* proxy, vtkSMPropertyGroup* group, QWidget* parent)
   : Superclass("representations", "HandleWidgetRepresentation", proxy, group, parent)
+  , Form(new Ui::RGSeedPointsWidget())
 {
   this->setObjectName("RGSeedPoints");
   this->setShowLabel(false);
+  this->createHandle(proxy);
+  this->setupUserObserver(proxy);
 
-  // The handle is a widget proxy of its own, on the session that renders (for Catalyst, the
-  // display session). It is not linked to any property of the filter: it only points.
+  // The form (pqRGSeedPointsPropertyWidget.ui), then what depends on the font.
+  this->Form->setupUi(this);
+  this->Table = this->Form->SeedTable;
+  this->Position[0] = this->Form->HandleX;
+  this->Position[1] = this->Form->HandleY;
+  this->Position[2] = this->Form->HandleZ;
+  this->Table->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  this->Table->verticalHeader()->setDefaultSectionSize(this->fontMetrics().height() + 6);
+  this->Table->setMinimumHeight(4 * (this->fontMetrics().height() + 6));
+  this->connectControls();
+  this->setWidgetVisible(this->Form->ShowHandle->isChecked());
+
+  // P puts the handle on the surface under the mouse, Ctrl+P on the nearest mesh point.
+  for (bool onMesh : { false, true })
+  {
+    auto* picker = new pqPointPickingHelper(
+      onMesh ? QKeySequence(tr("Ctrl+P")) : QKeySequence(tr("P")), onMesh, this);
+    QObject::connect(this, &pqPropertyWidget::viewChanged, picker, &pqPointPickingHelper::setView);
+    QObject::connect(
+      picker, &pqPointPickingHelper::pick, this, &pqRGSeedPointsPropertyWidget::setHandlePosition);
+  }
+
+  if (vtkSMProperty* seeds = group->GetProperty("SeedPoints"))
+  {
+    this->addPropertyLink(this, "seedPoints", SIGNAL(seedPointsChanged()), seeds);
+  }
+  else
+  {
+    qCritical("The seed points widget needs a property for the function 'SeedPoints'.");
+  }
+  this->showHandlePosition();
+}
+
+//-----------------------------------------------------------------------------
+// The handle is a widget proxy of its own, on the session that renders (for Catalyst, the
+// display session). It is not linked to any property of the filter: it only points.
+void pqRGSeedPointsPropertyWidget::createHandle(vtkSMProxy* proxy)
+{
   {
     pqScopedUndoExclude noUndo;
     pqServer* server =
@@ -70,104 +101,32 @@ pqRGSeedPointsPropertyWidget::pqRGSeedPointsPropertyWidget(
   }
   pqCoreUtilities::connect(
     this->Handle, vtkCommand::InteractionEvent, this, SLOT(handleMoved()), Qt::QueuedConnection);
-  pqCoreUtilities::connect(this->Handle, vtkCommand::EndInteractionEvent, this,
-    SLOT(handleMoved()), Qt::QueuedConnection);
-  this->setupUserObserver(proxy);
+  pqCoreUtilities::connect(
+    this->Handle, vtkCommand::EndInteractionEvent, this, SLOT(handleMoved()), Qt::QueuedConnection);
+}
 
-  // The seed table, linked to SeedPoints.
-  auto* layout = new QVBoxLayout(this);
-  layout->setContentsMargins(0, 0, 0, 0);
-  auto* seedsLabel = new QLabel(tr("<b>Seed Points</b> (world coordinates)"), this);
-  layout->addWidget(seedsLabel);
-  this->Table = new QTableWidget(0, 3, this);
-  this->Table->setObjectName("SeedTable");
-  this->Table->setHorizontalHeaderLabels({ "X", "Y", "Z" });
-  this->Table->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
-  this->Table->verticalHeader()->setDefaultSectionSize(this->fontMetrics().height() + 6);
-  this->Table->setSelectionBehavior(QAbstractItemView::SelectRows);
-  this->Table->setMinimumHeight(4 * (this->fontMetrics().height() + 6));
-  this->Table->setToolTip(tr("The seeds: each selects the surface vertex nearest to it. Edit a "
-                             "cell to move a seed; select a row to move the handle there."));
-  layout->addWidget(this->Table);
-  QObject::connect(this->Table, &QTableWidget::itemChanged, this, [this]() { this->tableEdited(); });
-  QObject::connect(this->Table, &QTableWidget::itemSelectionChanged, this,
-    &pqRGSeedPointsPropertyWidget::seedSelected);
-
-  auto* seedButtons = new QHBoxLayout();
-  auto* add = new QPushButton(tr("Add Seed"), this);
-  add->setObjectName("AddSeed");
-  add->setToolTip(tr("Add the handle's position to the seeds"));
-  auto* remove = new QPushButton(tr("Remove"), this);
-  remove->setObjectName("RemoveSeeds");
-  remove->setToolTip(tr("Remove the selected seeds"));
-  auto* removeAll = new QPushButton(tr("Remove All"), this);
-  removeAll->setObjectName("RemoveAllSeeds");
-  removeAll->setToolTip(tr("Remove every seed"));
-  seedButtons->addWidget(add);
-  seedButtons->addWidget(remove);
-  seedButtons->addWidget(removeAll);
-  layout->addLayout(seedButtons);
-  QObject::connect(add, &QPushButton::clicked, this, &pqRGSeedPointsPropertyWidget::addSeedAtHandle);
+//-----------------------------------------------------------------------------
+// The form's controls to what they do: the seed table and its buttons, the handle's position
+// fields, its visibility, and centring it.
+void pqRGSeedPointsPropertyWidget::connectControls()
+{
+  using Self = pqRGSeedPointsPropertyWidget;
   QObject::connect(
-    remove, &QPushButton::clicked, this, &pqRGSeedPointsPropertyWidget::removeSelectedSeeds);
+    this->Table, &QTableWidget::itemChanged, this, [this]() { this->tableEdited(); });
+  QObject::connect(this->Table, &QTableWidget::itemSelectionChanged, this, &Self::seedSelected);
+  QObject::connect(this->Form->AddSeed, &QPushButton::clicked, this, &Self::addSeedAtHandle);
   QObject::connect(
-    removeAll, &QPushButton::clicked, this, &pqRGSeedPointsPropertyWidget::removeAllSeeds);
-
-  // The handle: its position, a visibility switch, and how to place it.
-  auto* handleGrid = new QGridLayout();
-  handleGrid->addWidget(new QLabel(tr("Handle"), this), 0, 0);
+    this->Form->RemoveSeeds, &QPushButton::clicked, this, &Self::removeSelectedSeeds);
+  QObject::connect(this->Form->RemoveAllSeeds, &QPushButton::clicked, this, &Self::removeAllSeeds);
   for (int axis = 0; axis < 3; ++axis)
   {
-    this->Position[axis] = new pqDoubleLineEdit(this);
-    this->Position[axis]->setObjectName(QString("Handle%1").arg(AxisNames[axis]));
-    this->Position[axis]->setToolTip(tr("The handle's %1 coordinate").arg(AxisNames[axis]));
-    handleGrid->addWidget(this->Position[axis], 0, axis + 1);
     QObject::connect(this->Position[axis], &pqDoubleLineEdit::textChangedAndEditingFinished, this,
-      &pqRGSeedPointsPropertyWidget::handlePositionTyped);
+      &Self::handlePositionTyped);
   }
-  layout->addLayout(handleGrid);
-  auto* handleButtons = new QHBoxLayout();
-  auto* show = new QCheckBox(tr("Show Handle"), this);
-  show->setObjectName("ShowHandle");
-  show->setChecked(true);
-  auto* center = new QPushButton(tr("Center on Bounds"), this);
-  center->setObjectName("CenterOnBounds");
-  center->setToolTip(tr("Move the handle to the centre of the input's bounds"));
-  handleButtons->addWidget(show);
-  handleButtons->addWidget(center);
-  layout->addLayout(handleButtons);
-  auto* help = new QLabel(tr("<p>Press <b>P</b> over a slice or surface in the render view to put "
-                             "the handle there, <b>Ctrl+P</b> to snap it to the nearest mesh "
-                             "point, or drag it; then <b>Add Seed</b>.</p>"),
-    this);
-  help->setWordWrap(true);
-  layout->addWidget(help);
-  QObject::connect(show, &QCheckBox::toggled, this, &pqRGSeedPointsPropertyWidget::setWidgetVisible);
-  QObject::connect(this, &pqRGSeedPointsPropertyWidget::widgetVisibilityToggled, show,
-    &QCheckBox::setChecked);
-  QObject::connect(
-    center, &QPushButton::clicked, this, &pqRGSeedPointsPropertyWidget::centerOnBounds);
-  this->setWidgetVisible(show->isChecked());
-
-  for (bool onMesh : { false, true })
-  {
-    auto* picker = new pqPointPickingHelper(
-      onMesh ? QKeySequence(tr("Ctrl+P")) : QKeySequence(tr("P")), onMesh, this);
-    QObject::connect(
-      this, &pqPropertyWidget::viewChanged, picker, &pqPointPickingHelper::setView);
-    QObject::connect(picker, &pqPointPickingHelper::pick, this,
-      &pqRGSeedPointsPropertyWidget::setHandlePosition);
-  }
-
-  if (vtkSMProperty* seeds = group->GetProperty("SeedPoints"))
-  {
-    this->addPropertyLink(this, "seedPoints", SIGNAL(seedPointsChanged()), seeds);
-  }
-  else
-  {
-    qCritical("The seed points widget needs a property for the function 'SeedPoints'.");
-  }
-  this->showHandlePosition();
+  QCheckBox* show = this->Form->ShowHandle;
+  QObject::connect(show, &QCheckBox::toggled, this, &Self::setWidgetVisible);
+  QObject::connect(this, &Self::widgetVisibilityToggled, show, &QCheckBox::setChecked);
+  QObject::connect(this->Form->CenterOnBounds, &QPushButton::clicked, this, &Self::centerOnBounds);
 }
 
 //-----------------------------------------------------------------------------

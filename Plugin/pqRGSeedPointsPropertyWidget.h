@@ -24,14 +24,21 @@
 #include <QList>
 #include <QVariant>
 
+#include <memory>
+
 class QTableWidget;
 class pqDoubleLineEdit;
 class vtkSMNewWidgetRepresentationProxy;
+namespace Ui
+{
+class RGSeedPointsWidget;
+}
 
 class pqRGSeedPointsPropertyWidget : public pqInteractivePropertyWidgetAbstract
 {
   Q_OBJECT
-  Q_PROPERTY(QList<QVariant> seedPoints READ seedPoints WRITE setSeedPoints NOTIFY seedPointsChanged)
+  Q_PROPERTY(
+    QList<QVariant> seedPoints READ seedPoints WRITE setSeedPoints NOTIFY seedPointsChanged)
   using Superclass = pqInteractivePropertyWidgetAbstract;
 
 public:
@@ -78,10 +85,13 @@ private Q_SLOTS:
 private:
   Q_DISABLE_COPY(pqRGSeedPointsPropertyWidget)
 
+  void createHandle(vtkSMProxy* proxy);
+  void connectControls();
   void showHandlePosition();
   vtkBoundingBox inputBounds();
 
   vtkSmartPointer<vtkSMNewWidgetRepresentationProxy> Handle;
+  std::unique_ptr<Ui::RGSeedPointsWidget> Form; // the form: pqRGSeedPointsPropertyWidget.ui
   QTableWidget* Table = nullptr;
   pqDoubleLineEdit* Position[3] = { nullptr, nullptr, nullptr };
   bool Updating = false;
