@@ -11,6 +11,7 @@
 #include "rgmcDistributedData.h"
 #include "rgmcTestController.h"
 #include "rgmcTestData.h"
+#include "rgmcUnitedMesh.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellLocator.h"
@@ -166,51 +167,8 @@ vtkSmartPointer<vtkPolyData> Repair(vtkMultiProcessController* controller, vtkPo
 /// The surface as the Merged Surface Writer writes it: vertices by global id (position and normal
 /// bits), triangles rank after rank in their order, as global-id triples; and what the union
 /// must satisfy.
-struct Merged
+struct Merged : rgmc_test::UnitedMesh<double>
 {
-  std::map<long long, std::array<std::uint64_t, 6>> Points;
-  std::vector<std::array<long long, 3>> Triangles;
-  std::map<long long, int> Owners;
-  long long Inconsistent = 0;
-
-  void Add(vtkPolyData* pd)
-  {
-    if (pd->GetNumberOfPoints() == 0)
-    {
-      return;
-    }
-    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
-    vtkDataArray* ghosts = pd->GetPointData()->GetArray(vtkDataSetAttributes::GhostArrayName());
-    vtkDataArray* normals = pd->GetPointData()->GetNormals();
-    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
-    {
-      double x[3], n[3] = { 0, 0, 0 };
-      pd->GetPoint(p, x);
-      if (normals)
-      {
-        normals->GetTuple(p, n);
-      }
-      std::array<std::uint64_t, 6> bits;
-      for (int k = 0; k < 3; ++k)
-      {
-        std::memcpy(&bits[k], &x[k], 8);
-        std::memcpy(&bits[3 + k], &n[k], 8);
-      }
-      const long long gid = ids->GetValue(p);
-      auto inserted = this->Points.emplace(gid, bits);
-      this->Inconsistent += !inserted.second && inserted.first->second != bits;
-      this->Owners[gid] += ghosts && ghosts->GetComponent(p, 0) != 0 ? 0 : 1;
-    }
-    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
-    {
-      vtkIdType npts;
-      const vtkIdType* pts;
-      pd->GetCellPoints(t, npts, pts);
-      this->Triangles.push_back(
-        { ids->GetValue(pts[0]), ids->GetValue(pts[1]), ids->GetValue(pts[2]) });
-    }
-  }
-
   /// Edges used by one triangle, and edges not used exactly once in each direction.
   void CountEdges(long long& boundary, long long& bad, long long& edges) const
   {

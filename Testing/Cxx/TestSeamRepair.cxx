@@ -9,6 +9,7 @@
 #include "rgmcDistributedData.h"
 #include "rgmcTestController.h"
 #include "rgmcTestData.h"
+#include "rgmcUnitedMesh.h"
 
 #include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"
@@ -143,56 +144,8 @@ long long Field(vtkPolyData* pd, const char* name)
   return a ? a->GetValue(0) : -1;
 }
 
-/// A repaired surface by global point id: positions and normals as bits, triangles as sorted
-/// id triples, and what the union of pieces must satisfy.
-struct Mesh
-{
-  std::map<long long, std::array<std::uint32_t, 6>> Points;
-  std::set<std::array<long long, 3>> Triangles;
-  std::map<long long, int> Owners; // copies not flagged as duplicates
-  long long Inconsistent = 0, DuplicatedTriangles = 0;
-
-  void Add(vtkPolyData* pd)
-  {
-    if (pd->GetNumberOfPoints() == 0)
-    {
-      return;
-    }
-    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
-    vtkDataArray* ghosts = pd->GetPointData()->GetArray(vtkDataSetAttributes::GhostArrayName());
-    vtkDataArray* normals = pd->GetPointData()->GetNormals();
-    for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p)
-    {
-      double x[3], n[3] = { 0, 0, 0 };
-      pd->GetPoint(p, x);
-      if (normals)
-      {
-        normals->GetTuple(p, n);
-      }
-      std::array<std::uint32_t, 6> bits;
-      for (int k = 0; k < 3; ++k)
-      {
-        const float xf = static_cast<float>(x[k]), nf = static_cast<float>(n[k]);
-        std::memcpy(&bits[k], &xf, 4);
-        std::memcpy(&bits[3 + k], &nf, 4);
-      }
-      const long long gid = ids->GetValue(p);
-      auto inserted = this->Points.emplace(gid, bits);
-      this->Inconsistent += !inserted.second && inserted.first->second != bits;
-      this->Owners[gid] += ghosts->GetComponent(p, 0) == 0 ? 1 : 0;
-    }
-    for (vtkIdType t = 0; t < pd->GetNumberOfCells(); ++t)
-    {
-      vtkIdType npts;
-      const vtkIdType* pts;
-      pd->GetCellPoints(t, npts, pts);
-      std::array<long long, 3> tri = { ids->GetValue(pts[0]), ids->GetValue(pts[1]),
-        ids->GetValue(pts[2]) };
-      std::sort(tri.begin(), tri.end());
-      this->DuplicatedTriangles += !this->Triangles.insert(tri).second;
-    }
-  }
-};
+/// A repaired surface by global point id, positions and normals as float bits.
+using Mesh = rgmc_test::UnitedMesh<float>;
 
 /// Checks on every rank, then the gathered union against the 1-rank mesh.
 void Compare(vtkMultiProcessController* controller, vtkPolyData* piece, const Mesh* reference,
@@ -219,17 +172,16 @@ void Compare(vtkMultiProcessController* controller, vtkPolyData* piece, const Me
   RGMC_CHECK(static_cast<long long>(united.Points.size()) == unique &&
       (united.Points.empty() || united.Points.rbegin()->first == unique - 1),
     what << ": global ids are not 0.." << unique - 1);
-  long long badOwners = 0;
-  for (const auto& o : united.Owners)
-  {
-    badOwners += o.second != 1;
-  }
+  const long long badOwners = united.BadOwners();
   RGMC_CHECK(badOwners == 0, what << ": " << badOwners << " vertices without exactly one owner");
   RGMC_CHECK(united.Inconsistent == 0, what << ": " << united.Inconsistent << " copies differ");
-  RGMC_CHECK(united.DuplicatedTriangles == 0, what << ": triangles on two ranks");
+  long long duplicated = 0, referenceDuplicated = 0;
+  const auto triangles = united.SortedTriangles(duplicated);
+  RGMC_CHECK(duplicated == 0, what << ": triangles on two ranks");
   if (reference)
   {
-    RGMC_CHECK(united.Triangles == reference->Triangles, what << ": triangles differ from 1 rank");
+    RGMC_CHECK(triangles == reference->SortedTriangles(referenceDuplicated),
+      what << ": triangles differ from 1 rank");
     long long differ = 0;
     for (const auto& p : united.Points)
     {
