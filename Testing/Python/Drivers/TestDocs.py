@@ -25,6 +25,8 @@ sys.path[:0] = [os.path.join(HERE, "..", "Modules"), os.path.join(HERE, "..")]
 from rgmc_testing import check, finish, run, xvfb_run  # noqa: E402
 
 README_MAX_LINES = 300
+# The evaluation page holds the figures, not the history of how they were reached.
+EVALUATION_MAX_LINES = 400
 # The README's set-up commands, exactly as a newcomer types them.
 SETUP_COMMANDS = [
     "./rgmc demo    # install what is missing, build, read a real head CT, extract its skull "
@@ -135,6 +137,10 @@ def check_readme(readme, docs):
     for page in docs:
         check(any("](../README.md)" in line for line in page.lines[:6]),
               "%s links back to the README at its top" % page.name)
+        if page.name == os.path.join("docs", "evaluation.md"):
+            count = len(page.lines) - (page.lines[-1] == "")
+            check(count <= EVALUATION_MAX_LINES, "docs/evaluation.md has at most %d lines (it has %d)"
+                  % (EVALUATION_MAX_LINES, count))
 
 
 def accepted_options(source, script):
@@ -298,7 +304,8 @@ def main():
     docs = [Page(args.source, os.path.relpath(p, args.source))
             for p in sorted(glob.glob(os.path.join(args.source, "docs", "*.md")))]
     check(len(docs) > 0, "docs/ holds pages")
-    pages = [readme] + docs
+    contributing = Page(args.source, "CONTRIBUTING.md")
+    pages = [readme, contributing] + docs
     check_links(args.source, pages)
     check_readme(readme, docs)
     check_named_things(args.source, pages)
