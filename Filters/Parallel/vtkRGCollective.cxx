@@ -59,8 +59,8 @@ bool Ranks::Agree(bool ok, std::string& message, std::initializer_list<bool*> an
     mine.push_back(*value);
   }
   ++this->Collectives;
-  if (this->MultiProcess->AllReduce(mine.data(), reduced.data(), static_cast<vtkIdType>(mine.size()),
-        vtkCommunicator::MIN_OP) != 1)
+  if (this->MultiProcess->AllReduce(mine.data(), reduced.data(),
+        static_cast<vtkIdType>(mine.size()), vtkCommunicator::MIN_OP) != 1)
   {
     // The agreement itself failed: nothing more can be trusted of the other ranks.
     message = "communication between the ranks failed (agreeing on a status)";
@@ -165,15 +165,16 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>
       for (vtkIdType at = 0; at < count; at += MaxChunk)
       {
         ++this->Messages;
-        this->Check(this->MultiProcess->Send(outgoing[partner].data() + at, std::min(MaxChunk, count - at),
-                      partner, tag + 1),
+        this->Check(this->MultiProcess->Send(outgoing[partner].data() + at,
+                      std::min(MaxChunk, count - at), partner, tag + 1),
           "sending a message");
       }
     };
     auto receive = [&]()
     {
       vtkIdType count = 0;
-      this->Check(this->MultiProcess->Receive(&count, 1, partner, tag), "receiving a message's size");
+      this->Check(
+        this->MultiProcess->Receive(&count, 1, partner, tag), "receiving a message's size");
       std::vector<T>& in = incoming[partner];
       T* target = nullptr;
       try
@@ -198,7 +199,8 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>
         {
           break; // the agreement that follows fails anyway (Failure is set)
         }
-        this->Check(this->MultiProcess->Receive(target ? target + at : drain, length, partner, tag + 1),
+        this->Check(
+          this->MultiProcess->Receive(target ? target + at : drain, length, partner, tag + 1),
           "receiving a message");
       }
     };

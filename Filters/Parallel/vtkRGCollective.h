@@ -56,7 +56,8 @@ public:
     sent[0] = static_cast<T>(ok ? this->Size : this->Rank);
     std::copy(mine.begin(), mine.end(), sent.begin() + 1);
     ++this->Collectives;
-    if (this->MultiProcess->AllGather(sent.data(), gathered.data(), static_cast<vtkIdType>(sent.size())) != 1)
+    if (this->MultiProcess->AllGather(
+          sent.data(), gathered.data(), static_cast<vtkIdType>(sent.size())) != 1)
     {
       message = "communication between the ranks failed (agreeing on a status)";
       return false;

@@ -47,7 +47,8 @@ std::vector<double> SincCoefficients(int iterations, double passBand, SincWindow
     double fprime = cprime[0];
     for (int i = 1; i <= n; ++i)
     {
-      const double t = i == 1 ? 1.0 - 0.5 * kpb : std::cos(static_cast<double>(i) * std::acos(1.0 - 0.5 * kpb));
+      const double t =
+        i == 1 ? 1.0 - 0.5 * kpb : std::cos(static_cast<double>(i) * std::acos(1.0 - 0.5 * kpb));
       f += c[i] * t;
       fprime += cprime[i] * t;
     }
