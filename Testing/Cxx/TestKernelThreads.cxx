@@ -1,6 +1,6 @@
 // The kernel on threads, under ThreadSanitizer (built with -fsanitize=thread where the compiler
 // has it): seed search, growth and extraction over one piece with a ParallelFor of plain
-// std::threads that take tasks in whatever order they come, at 1, 2, 3 and 4 threads. Every
+// std::threads that take tasks in whatever order they come, at 1, 2, 3, 4, 16 and 64 threads. Every
 // output buffer (points, normals, keys, triangles, components, ports, component totals) must be
 // bitwise the same as on 1 thread. Volumes of several 32^3 tiles (growth crosses tiles) and
 // more than one chunk of slabs (extraction joins chunks), with samples equal to the isovalue;
@@ -171,7 +171,7 @@ int main()
       {
         const Result one = Run(values, mode, owners, owner, 1);
         RGMC_CHECK(one.Triangles > 1000, "a surface of " << one.Triangles << " triangles");
-        for (const int threads : { 2, 3, 4 })
+        for (const int threads : { 2, 3, 4, 16, 64 })
         {
           const Result many = Run(values, mode, owners, owner, threads);
           RGMC_CHECK(many.Bytes == one.Bytes,
