@@ -22,8 +22,7 @@ enum Tags
 {
   TrianglesTag = 7401,
   SharedTag = 7402,
-  AnswersTag = 7403,
-  HaloTag = 7404
+  AnswersTag = 7403
 };
 
 /// Every rank as a partner of an exchange.
