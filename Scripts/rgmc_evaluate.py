@@ -50,6 +50,18 @@ The ranks benchmark instead: the build's rgmcRanks program on 1, 2 and 4 ranks (
 small sphere in a 3-D scaffold of rods (256^3 float), seeded on the sphere against All
 Components in the same run, seeded on a rod (the scaffold as the chosen structure), and the CT phantom (512^3) seeded on the skull, with the filter's
 rounds of growth between ranks, collectives and messages. Writes ranks.md and ranks.json.
+
+  python3 Scripts/rgmc_evaluate.py --span     # or: ./rgmc evaluate --span
+
+The work/span profile instead: the build's rgmcSpanBenchmark program, one rank. Each stage
+(Seeded, Largest and All on the phantom's skull, the noisy head and the dense gyroid; Seam Repair
++ 20 Laplacian and Decimate Surface to 10% on the skull) runs on one thread with every serial
+section and every parallel task timed: per stage and phase the work W, the span S (the serial
+sections plus each parallel step's longest task), W/S, and the predicted time on p threads,
+S + (W - S)/p, for p = 2, 4, 16, 64, set against the 2-thread time measured in the same run, with
+vtkFlyingEdges3D's 1- and 2-thread times. Where prediction and measure differ by more than 15%,
+the report gives the page faults of the measured run at this machine's cost of one. Writes
+span.md and span.json.
 """
 
 import argparse
@@ -678,6 +690,83 @@ def decimate_report(rows, args):
     return "\n".join(lines) + "\n"
 
 
+
+def run_span(args):
+    command = [args.span_binary, "--size", str(args.threads_size), "--ct-size",
+               str(args.kernel_ct_size), "--dense-size", str(args.kernel_dense_size), "--repeats",
+               str(args.kernel_repeats), "--decimate-repeats", str(args.decimate_repeats)]
+    return run_json(command, "rgmcSpanBenchmark")
+
+
+SPAN_TARGETS = {"seeded": 64, "all components": 64, "Seam Repair + 20 Laplacian": 64,
+                "Decimate Surface to 10%": 32}
+GAIN_TARGETS = {"seeded": 1.8, "Seam Repair + 20 Laplacian": 1.8, "Decimate Surface to 10%": 1.7}
+
+
+def span_report(result, args):
+    stages = result["stages"]
+    fault = result["fault_seconds"]
+    lines = report_header("# RGMC work/span profile") + [
+        "Each stage on one thread, every serial section and parallel task timed (the run of least "
+        "work of %d; Decimate %d): W the work, S the span (serial sections plus each parallel "
+        "step's longest task), T(p) = S + (W - S)/p. Measured: minimum of the repeats, re-run in "
+        "one process (STDThread). A minor page fault costs %.2f us here." % (
+            result["repeats"], result["decimate_repeats"], 1e6 * fault), "",
+        "| volume | stage | triangles | W (s) | S (s) | W/S | T(2) predicted | T(2) measured | "
+        "measured 1 -> 2 | T(4) | T(16) | T(64) | FE 1 thread | FE 2 threads |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in stages:
+        fe = r.get("flying_edges")
+        p, m = r["predicted"], r["measured"]
+        lines.append("| %s | %s | %d | %.3f | %.4f | %.0f | %.3f | %.3f | x%.2f | %.3f | %.4f | %.4f | %s | %s |" % (
+            r["volume"], r["stage"], r["triangles"], r["work"], r["span"], r["parallelism"], p["2"],
+            m["2"], m["1"] / m["2"], p["4"], p["16"], p["64"],
+            "%.3f" % fe["1"] if fe else "", "%.3f" % fe["2"] if fe else ""))
+    lines += ["", "## What the model misses", ""]
+    missed = False
+    for r in stages:
+        predicted, measured = r["predicted"]["2"], r["measured"]["2"]
+        if abs(measured - predicted) > 0.15 * measured:
+            missed = True
+            faults = r["minor_faults"]["2"]
+            lines.append(
+                "- %s, %s: 2 threads measured %.3f s against %.3f s predicted (%+.0f%%). The measured "
+                "run took %d minor page faults (%.3f s at %.2f us each; %d on one thread); the "
+                "work measured on one thread was %.3f s against the profile's %.3f s." % (
+                    r["volume"], r["stage"], measured, predicted, 100 * (measured - predicted) / predicted,
+                    faults, faults * fault, 1e6 * fault, r["minor_faults"]["1"], r["measured"]["1"],
+                    r["work"]))
+    if not missed:
+        lines.append("- every 2-thread prediction within 15% of the measure")
+    lines += ["", "## Phases (share of the stage's span)", "",
+              "| volume | stage | phase | W (s) | S (s) | W/S | steps | tasks | share of S |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for r in stages:
+        for ph in r["phases"]:
+            if ph["work"] < 0.005 * r["work"] and ph["span"] < 0.05 * r["span"]:
+                continue
+            lines.append("| %s | %s | %s | %.4f | %.4f | %.1f | %d | %d | %.0f%% |" % (
+                r["volume"], r["stage"], ph["name"], ph["work"], ph["span"],
+                ph["work"] / ph["span"] if ph["span"] > 0 else float("inf"), ph["steps"], ph["tasks"],
+                100 * ph["span"] / r["span"]))
+    lines += ["", "## Targets", ""]
+    for r in stages:
+        target = SPAN_TARGETS.get(r["stage"])
+        if target:
+            lines.append("- %s, %s: W/S %.0f >= %d: %s" % (
+                r["volume"], r["stage"], r["parallelism"], target, "met" if r["parallelism"] >= target else "NOT met"))
+        if r["stage"] == "seeded" and r.get("flying_edges"):
+            limit = 0.2 * r["flying_edges"]["1"] / 16
+            lines.append("- %s, seeded T(16) predicted %.4f s <= 0.2 x FE 1 thread / 16 = %.4f s: %s" % (
+                r["volume"], r["predicted"]["16"], limit, "met" if r["predicted"]["16"] <= limit else "NOT met"))
+        gain = GAIN_TARGETS.get(r["stage"])
+        if gain and (r["stage"] != "seeded" or not r["volume"].startswith("gyroid")):
+            measured = r["measured"]["1"] / r["measured"]["2"]
+            lines.append("- %s, %s from the second thread >= x%.1f: x%.2f, %s" % (
+                r["volume"], r["stage"], gain, measured, "met" if measured >= gain else "NOT met"))
+    return "\n".join(lines) + "\n"
+
+
 def write_results(folder, name, results, text):
     """Writes <name>.json and <name>.md (the report `text`) into `folder` and prints the report."""
     os.makedirs(folder, exist_ok=True)
@@ -739,6 +828,9 @@ def main(argv):
     parser.add_argument("--decimate-reduction", type=float, default=0.9)
     parser.add_argument("--decimate-repeats", type=int, default=3)
     parser.add_argument("--decimate-binary", default=os.path.join(build, "bin", "rgmcDecimateBenchmark"))
+    parser.add_argument("--span", action="store_true",
+                        help="the work/span profile instead (rgmcSpanBenchmark, one rank)")
+    parser.add_argument("--span-binary", default=os.path.join(build, "bin", "rgmcSpanBenchmark"))
     parser.add_argument("--report-only", action="store_true",
                         help="write report.md and the plots again from the last results.json, without measuring")
     args = parser.parse_args(argv)
@@ -754,6 +846,11 @@ def main(argv):
             raise rgmc_common.UsageError("no kernel program at %s: build first (./rgmc build)" % args.kernel_binary)
         result = run_kernel(args)
         return write_results(args.output, "kernel", result, kernel_report(result, args))
+    if args.span:
+        if not os.path.isfile(args.span_binary):
+            raise rgmc_common.UsageError("no span program at %s: build first (./rgmc build)" % args.span_binary)
+        result = run_span(args)
+        return write_results(args.output, "span", result, span_report(result, args))
     if args.decimate:
         if not os.path.isfile(args.decimate_binary):
             raise rgmc_common.UsageError("no decimation program at %s: build first (./rgmc build)" % args.decimate_binary)

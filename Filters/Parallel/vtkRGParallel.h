@@ -5,6 +5,7 @@
 #ifndef vtkRGParallel_h
 #define vtkRGParallel_h
 
+#include "vtkRGSpan.h"
 #include "vtkSMPTools.h"
 #include "vtkType.h"
 
@@ -17,12 +18,25 @@
 namespace rgmc
 {
 
+/// True when one thread runs, so that a filter may take a serial path instead of a parallel
+/// one with the same result; false while the work/span profile records the parallel paths.
+inline bool SingleThreaded()
+{
+  return vtkSMPTools::GetEstimatedNumberOfThreads() <= 1 && !SpanRecorder::Recording();
+}
+
 /// Calls body(begin, end) over ranges covering [0, count) exactly once, on vtkSMPTools'
 /// threads, `grain` indices or more at a time. The first exception a range throws stops the
 /// ranges not yet started and is thrown again here. Results must not depend on the ranges.
+/// While a work/span profile records, the ranges are the grains, timed one by one.
 template <typename Body>
 void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
 {
+  if (SpanRecorder* recorder = SpanRecorder::Recording())
+  {
+    recorder->Step(count, grain, body);
+    return;
+  }
   std::exception_ptr failure;
   std::mutex failureMutex;
   std::atomic<bool> failed{ false };
@@ -62,7 +76,7 @@ void ParallelSort(Vector& values)
   const std::size_t n = values.size();
   const std::size_t slice = std::max<std::size_t>(4096, (n + 63) / 64);
   // One thread: the merges would only add copies (the result is the same either way).
-  if (n <= slice || vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
+  if (n <= slice || SingleThreaded())
   {
     std::sort(values.begin(), values.end());
     return;

@@ -176,7 +176,7 @@ private:
   /// going through AddVertex. The same rows, in the same order, for any number of threads.
   void AddUnsharedVertices(bool stencils, Checks& checks)
   {
-    if (vtkSMPTools::GetEstimatedNumberOfThreads() <= 1)
+    if (rgmc::SingleThreaded())
     {
       this->AddUnsharedVerticesInOrder(stencils, checks);
       return;

@@ -11,6 +11,7 @@
 #include "vtkRGParallel.h"
 #include "vtkRGRunController.h"
 #include "vtkRGSeamRepair.h"
+#include "vtkRGSpan.h"
 
 #include "vtkCellArray.h"
 #include "vtkDataArray.h"
@@ -362,6 +363,7 @@ int vtkRGDecimate::RequestData(
   };
 
   // PASS 0-1: a numbered triangle mesh, read in place.
+  rgmc::SpanMark("read surface");
   if (!this->CheckInput(run) || !this->ReadSurface(run))
   {
     return fail();
@@ -370,13 +372,20 @@ int vtkRGDecimate::RequestData(
   for (int pass = 0; pass < MaximumPasses && run.Triangles > run.Target; ++pass)
   {
     // PASS 2-7: one pass of block simplification, its blocks made and simplified in waves.
+    rgmc::SpanMark("place blocks");
     if (!this->PlaceBlocks(run, pass) || !this->FindSharedVertices(run))
     {
       return fail();
     }
     for (int wave = 0; wave < run.Waves; ++wave)
     {
-      if (!this->SendTriangles(run, wave) || !this->SimplifyBlocks(run, wave))
+      rgmc::SpanMark("send triangles");
+      if (!this->SendTriangles(run, wave))
+      {
+        return fail();
+      }
+      rgmc::SpanMark("simplify blocks");
+      if (!this->SimplifyBlocks(run, wave))
       {
         return fail();
       }
@@ -385,6 +394,7 @@ int vtkRGDecimate::RequestData(
         ReleaseFreeMemory(); // the wave's meshes and messages
       }
     }
+    rgmc::SpanMark("keep cheapest, apply collapses");
     if (!this->KeepCheapest(run, pass >= AllFromPass) || !this->ApplyCollapses(run))
     {
       return fail();
@@ -400,6 +410,7 @@ int vtkRGDecimate::RequestData(
     }
   }
   // PASS 8: one mesh again, with normals, checks and measures.
+  rgmc::SpanMark("decimated piece");
   if (!this->NumberSurface(run, output))
   {
     return fail();
@@ -1077,6 +1088,7 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
     return false;
   }
   vtkNew<vtkRGSeamRepair> numbering;
+  rgmc::SpanPrefix phases("numbering: ", "after numbering");
   numbering->SetController(run.Ranks.Controller());
   numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
   numbering->SetInputData(piece);

@@ -11,6 +11,7 @@
 #include "vtkRGMessage.h"
 #include "vtkRGParallel.h"
 #include "vtkRGRunController.h"
+#include "vtkRGSpan.h"
 
 #include "vtkArrayDispatch.h"
 #include "vtkCellArray.h"
@@ -256,6 +257,7 @@ int vtkRGMarchingCubes::RequestData(
   } accounting{ this, run };
 
   // PASS 0: check the input on every rank and agree on the verdict.
+  rgmc::SpanMark("check input");
   if (!this->CheckInput(run, input, inputVector))
   {
     vtkErrorMacro(<< "Cannot extract a surface: " << run.Problem << ".");
@@ -263,11 +265,13 @@ int vtkRGMarchingCubes::RequestData(
   }
   this->UpdateProgress(0.05);
   // PASS 1: ownership of cubes; the kernel over this rank's samples.
+  rgmc::SpanMark("cubes and kernel");
   this->AssignCubes(run);
   this->BuildKernel(run);
   // PASS 2: seeds, each to its nearest surface vertex over all ranks.
   if (this->ExtractionMode == SEEDED)
   {
+    rgmc::SpanMark("seed search");
     const int found = this->FindSeeds(run);
     if (found <= 0)
     {
@@ -284,10 +288,12 @@ int vtkRGMarchingCubes::RequestData(
   }
   this->UpdateProgress(0.8);
   // PASS 4: join components across ranks; decide what to keep (agreed in pass 5).
+  rgmc::SpanMark("component decision");
   Resolve(run.Ranks, Kept(this->ExtractionMode), run.Graph, run.Roots, run.Edges, run.Decision,
     run.Problem);
   this->UpdateProgress(0.9);
   // PASS 5: the output piece.
+  rgmc::SpanMark("output arrays");
   if (!this->StoreSurface(run, output))
   {
     vtkErrorMacro(<< "Cannot extract a surface: " << run.Problem << ".");
@@ -580,6 +586,7 @@ void vtkRGMarchingCubes::BuildKernel(Run& run)
     rgmc::ParallelFor(static_cast<vtkIdType>(count), vtkIdType(1),
       [&body](vtkIdType begin, vtkIdType end) { body(begin, end); });
   };
+  options.Phase = [](const char* phase) { rgmc::SpanMark(phase); };
   KernelBuilder builder{ run.Grid.get(), run.Ownership.get(), &options, nullptr };
   if (run.Scalars)
   {
@@ -735,6 +742,7 @@ void vtkRGMarchingCubes::GrowAndExtractLocally(Run& run, bool rounds, bool abort
     outOfMemory, "grow and extract the surface", run.Ranks.Rank,
     [&]()
     {
+      rgmc::SpanMark("growth");
       if (!rounds && this->ExtractionMode == SEEDED)
       {
         for (vtkIdType key : run.SeedVertexKeys)
@@ -749,8 +757,10 @@ void vtkRGMarchingCubes::GrowAndExtractLocally(Run& run, bool rounds, bool abort
       }
       if (!aborted)
       {
+        rgmc::SpanMark("extraction: nodes by slab");
         kernel.Extract();
         run.TrianglesMade = kernel.Mesh().NumberOfTriangles();
+        rgmc::SpanMark("component graph");
         run.Graph.Prepare(kernel, *run.Grid, *run.Ownership, run.Ranks.Rank, run.Ranks.Size);
       }
     },

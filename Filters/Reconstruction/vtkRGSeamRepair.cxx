@@ -11,6 +11,7 @@
 #include "vtkRGCollective.h"
 #include "vtkRGCompatibility.h"
 #include "vtkRGRunController.h"
+#include "vtkRGSpan.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
@@ -138,6 +139,7 @@ int vtkRGSeamRepair::RequestData(
   } accounting{ this, run };
 
   // PASS 0: a triangle mesh with triangles, on every rank.
+  rgmc::SpanMark("check input");
   if (!this->CheckInput(run))
   {
     vtkErrorMacro(<< "Cannot repair the seams: " << run.Problem << ".");
@@ -145,6 +147,7 @@ int vtkRGSeamRepair::RequestData(
   }
   this->UpdateProgress(0.05);
   // PASS 1: this rank's distinct vertices and their global numbering.
+  rgmc::SpanMark("numbering");
   if (!this->NumberVertices(run))
   {
     vtkErrorMacro(<< "Cannot repair the seams: " << run.Problem << ".");
@@ -152,6 +155,7 @@ int vtkRGSeamRepair::RequestData(
   }
   this->UpdateProgress(0.25);
   // PASS 2: how to tell edges on the volume's border.
+  rgmc::SpanMark("border");
   this->FindBorder(run);
   // PASS 3-5: edges at the seams, checks, smoothing, normals, the output points.
   if (!this->RepairSeams(run))
@@ -165,6 +169,7 @@ int vtkRGSeamRepair::RequestData(
     return 0;
   }
   // PASS 6: the global checks and the output piece.
+  rgmc::SpanMark("output");
   if (!this->StoreSurface(run, output))
   {
     vtkErrorMacro(<< "Cannot repair the seams: " << run.Problem << ".");
@@ -334,12 +339,15 @@ bool vtkRGSeamRepair::SmoothSurface(Run& run, Repair& repair)
     this->UpdateProgress(0.4 + 0.5 * fraction);
     return ranks.Any(this->CheckAbort());
   };
+  rgmc::SpanMark("smoothing");
   if (!repair.Smooth(settings, progress, run.Problem))
   {
     run.Aborted = run.Problem.empty();
     return false;
   }
+  rgmc::SpanMark("normals");
   run.Normals = repair.Normals(run.Problem);
+  rgmc::SpanMark("measures");
   return run.Normals &&
     rgmc::seam::MeasureSurface(
       ranks, repair, repair.Smoothed.data(), run.Box, run.After, run.Problem);
@@ -354,6 +362,7 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
   std::vector<T> copied; // the positions, when the input's cannot be used as they are
   const I* triangles = nullptr;
   // PASS 3: the input copied, the seams analysed (checks, stencils), the surface measured.
+  rgmc::SpanMark("copy input");
   if (!ranks.Step("copy the input", run.Problem,
         [&]()
         {
@@ -365,8 +374,13 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
   }
   PieceRepair<T, I> repair(ranks, run.Vertices, run.Numbering, run.Border, run.Keys, positions,
     triangles, run.Input->GetNumberOfPolys());
-  if (!repair.AnalyzeSeams(run.Smooth, run.Checks, run.Problem) ||
-    !rgmc::seam::MeasureSurface(ranks, repair, positions, run.Box, run.Before, run.Problem))
+  rgmc::SpanMark("seam analysis");
+  if (!repair.AnalyzeSeams(run.Smooth, run.Checks, run.Problem))
+  {
+    return false;
+  }
+  rgmc::SpanMark("measures");
+  if (!rgmc::seam::MeasureSurface(ranks, repair, positions, run.Box, run.Before, run.Problem))
   {
     return false;
   }
@@ -378,6 +392,7 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
     return false;
   }
   // PASS 5: the output's points: the input's own when nothing moved and nothing was merged.
+  rgmc::SpanMark("output points");
   return ranks.Step("store the output points", run.Problem,
     [&]()
     {

@@ -45,6 +45,9 @@ struct SurfaceOptions
   std::function<void(
     std::int64_t count, const std::function<void(std::int64_t begin, std::int64_t end)>& body)>
     ParallelFor;
+  /// Called, from the calling thread, when a phase of the work starts (the VTK layer passes the
+  /// work/span profile's marks). Empty: nothing.
+  std::function<void(const char* phase)> Phase;
 };
 
 /// The samples at the 8 corners of a cube (VTK's corner order) and its case.
@@ -93,6 +96,9 @@ public:
   }
   std::size_t size() const { return this->Count; }
   bool empty() const { return this->Count == 0; }
+  /// The blocks appended, in order.
+  std::size_t NumberOfBlocks() const { return this->Blocks.size(); }
+  const std::vector<SurfaceNode>& Block(std::size_t b) const { return this->Blocks[b]; }
   /// f(node) for every node, in order.
   template <typename F>
   void ForEach(F&& f) const

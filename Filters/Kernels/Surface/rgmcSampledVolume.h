@@ -122,6 +122,15 @@ public:
     }
   }
 
+  /// Names the phase of the work that starts here (Options.Phase). From the calling thread only.
+  void Mark(const char* phase)
+  {
+    if (this->Options.Phase)
+    {
+      this->Options.Phase(phase);
+    }
+  }
+
   /// Runs task(i) for every i in [0, count), through Options.ParallelFor. An exception thrown
   /// by a task stops the others and is thrown again here (the first one caught).
   template <typename Task>

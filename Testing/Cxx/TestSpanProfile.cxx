@@ -1,0 +1,207 @@
+// Unit test of the work/span profile (vtkRGSpan.h) on a clock the test drives: rgmc::ParallelFor
+// runs its grains in order, each once, each timed; a phase's work, span and predicted times are
+// the sums the definitions give; a loop inside a task is part of the task; a mark inside a task,
+// or with no recorder, does nothing; the prefix of a filter inside another; an exception leaves
+// the recorder usable; ParallelSort takes its parallel path while recording, with std::sort's
+// result; outside a recording, the loops run on vtkSMPTools as before.
+#include "rgmcCheck.h"
+#include "vtkRGParallel.h"
+#include "vtkRGSpan.h"
+
+#include "vtkSMPTools.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace
+{
+
+bool Near(double a, double b)
+{
+  return std::abs(a - b) < 1e-9;
+}
+
+const rgmc::SpanPhase* Find(const rgmc::SpanRecorder& recorder, const std::string& name)
+{
+  for (const rgmc::SpanPhase& p : recorder.Phases())
+  {
+    if (p.Name == name)
+    {
+      return &p;
+    }
+  }
+  return nullptr;
+}
+
+void TestAccounting()
+{
+  double now = 100;
+  rgmc::SpanRecorder recorder([&now]() { return now; });
+  RGMC_CHECK(!rgmc::SpanRecorder::Recording(), "no recorder before Start");
+  recorder.Start("setup");
+  RGMC_CHECK(rgmc::SpanRecorder::Recording() == &recorder, "recording after Start");
+  now += 5; // a serial section
+  // Grains of 3 over 10 indices, index i costing i + 1: grains cost 6, 15, 24 and 10.
+  std::vector<std::pair<vtkIdType, vtkIdType>> ranges;
+  std::vector<int> seen(10, 0);
+  rgmc::ParallelFor(10, 3,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      ranges.emplace_back(begin, end);
+      rgmc::SpanMark("inside a task"); // ignored: the task is part of its phase
+      for (vtkIdType i = begin; i < end; ++i)
+      {
+        ++seen[i];
+        now += static_cast<double>(i + 1);
+      }
+    });
+  const std::vector<std::pair<vtkIdType, vtkIdType>> grains = { { 0, 3 }, { 3, 6 }, { 6, 9 },
+    { 9, 10 } };
+  RGMC_CHECK(ranges == grains, "the grains, in order");
+  RGMC_CHECK(
+    std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }), "every index once");
+  rgmc::SpanMark("second");
+  now += 2;
+  // Four tasks, each a loop of three indices costing 1: the inner loops are the tasks' own.
+  rgmc::ParallelFor(4, 1,
+    [&](vtkIdType, vtkIdType)
+    {
+      RGMC_CHECK(!rgmc::SpanRecorder::Recording(), "no recording inside a task");
+      rgmc::ParallelFor(3, 1, [&](vtkIdType b, vtkIdType e) { now += static_cast<double>(e - b); });
+    });
+  rgmc::SpanMark("setup"); // continued
+  now += 1;
+  recorder.Stop();
+  RGMC_CHECK(!rgmc::SpanRecorder::Recording(), "no recording after Stop");
+  rgmc::SpanMark("after the stop"); // no recorder: nothing
+
+  RGMC_CHECK(recorder.Phases().size() == 2, recorder.Phases().size() << " phases, not 2");
+  const rgmc::SpanPhase* setup = Find(recorder, "setup");
+  const rgmc::SpanPhase* second = Find(recorder, "second");
+  RGMC_CHECK(setup && second, "the phases by name");
+  if (!setup || !second)
+  {
+    return;
+  }
+  RGMC_CHECK(Near(setup->Work, 61), "setup work " << setup->Work << ", not 5 + 55 + 1");
+  RGMC_CHECK(Near(setup->ParallelWork, 55), "setup parallel work " << setup->ParallelWork);
+  RGMC_CHECK(Near(setup->Span(), 30), "setup span " << setup->Span() << ", not 5 + 24 + 1");
+  RGMC_CHECK(setup->Steps == 1 && setup->Tasks == 4, setup->Steps << " steps, " << setup->Tasks);
+  RGMC_CHECK(Near(setup->Predicted(2), 30 + 31.0 / 2), "predicted " << setup->Predicted(2));
+  RGMC_CHECK(Near(setup->Predicted(1), 61), "predicted on one thread: the work");
+  RGMC_CHECK(Near(second->Work, 14), "second work " << second->Work << ", not 2 + 12");
+  RGMC_CHECK(Near(second->Span(), 5), "second span " << second->Span() << ", not 2 + 3");
+  RGMC_CHECK(second->Steps == 1 && second->Tasks == 4, "inner loops are not steps");
+  const rgmc::SpanPhase total = recorder.Total("total");
+  RGMC_CHECK(Near(total.Work, 75) && Near(total.Span(), 35),
+    "total work " << total.Work << ", span " << total.Span());
+}
+
+void TestPrefixAndExceptions()
+{
+  double now = 0;
+  rgmc::SpanRecorder recorder([&now]() { return now; });
+  recorder.Start();
+  {
+    rgmc::SpanPrefix inner("numbering: ", "after");
+    rgmc::SpanMark("sort");
+    now += 3;
+  }
+  now += 1;
+  bool thrown = false;
+  try
+  {
+    rgmc::ParallelFor(5, 1,
+      [&](vtkIdType begin, vtkIdType)
+      {
+        now += 1;
+        if (begin == 2)
+        {
+          throw std::runtime_error("task 2");
+        }
+      });
+  }
+  catch (const std::runtime_error&)
+  {
+    thrown = true;
+  }
+  RGMC_CHECK(thrown, "a task's exception reaches the caller");
+  RGMC_CHECK(rgmc::SpanRecorder::Recording() == &recorder, "recording again after the throw");
+  rgmc::SpanMark("last");
+  recorder.Stop();
+  const rgmc::SpanPhase* sort = Find(recorder, "numbering: sort");
+  const rgmc::SpanPhase* after = Find(recorder, "after");
+  RGMC_CHECK(sort && Near(sort->Work, 3), "the prefixed phase");
+  RGMC_CHECK(after && Near(after->Work, 4), "the phase after the prefix: 1 + three tasks");
+  RGMC_CHECK(Find(recorder, "last") != nullptr, "a mark after the throw");
+
+  rgmc::SpanRecorder first, second;
+  first.Start();
+  bool refused = false;
+  try
+  {
+    second.Start();
+  }
+  catch (const std::logic_error&)
+  {
+    refused = true;
+  }
+  first.Stop();
+  RGMC_CHECK(refused, "a second recorder at once is refused");
+}
+
+void TestSortAndThreads()
+{
+  std::mt19937_64 random(7);
+  std::vector<std::uint64_t> values(100000);
+  for (std::size_t i = 0; i < values.size(); ++i)
+  {
+    values[i] = (random() << 20) | i; // distinct
+  }
+  std::vector<std::uint64_t> expected = values;
+  std::sort(expected.begin(), expected.end());
+  vtkSMPTools::LocalScope(vtkSMPTools::Config{ 1, "STDThread", false },
+    [&]()
+    {
+      RGMC_CHECK(rgmc::SingleThreaded(), "one thread, no recording");
+      rgmc::SpanRecorder recorder;
+      recorder.Start();
+      RGMC_CHECK(!rgmc::SingleThreaded(), "recording takes the parallel paths");
+      std::vector<std::uint64_t> sorted = values;
+      rgmc::ParallelSort(sorted);
+      recorder.Stop();
+      RGMC_CHECK(sorted == expected, "ParallelSort while recording: std::sort's order");
+      RGMC_CHECK(recorder.Total("").Steps > 1, "ParallelSort's slices and merges are steps");
+    });
+  // Outside a recording: vtkSMPTools on several threads, every index once.
+  vtkSMPTools::LocalScope(vtkSMPTools::Config{ 4, "STDThread", false },
+    [&]()
+    {
+      std::vector<int> seen(1000, 0);
+      rgmc::ParallelFor(1000, 7,
+        [&](vtkIdType b, vtkIdType e)
+        {
+          for (vtkIdType i = b; i < e; ++i)
+          {
+            ++seen[i];
+          }
+        });
+      RGMC_CHECK(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }),
+        "threads: every index once");
+    });
+}
+
+} // namespace
+
+int main()
+{
+  TestAccounting();
+  TestPrefixAndExceptions();
+  TestSortAndThreads();
+  return rgmc_test::Result("TestSpanProfile");
+}
