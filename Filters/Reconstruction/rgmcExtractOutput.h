@@ -6,6 +6,7 @@
 #include "rgmcComponentGraph.h"
 #include "rgmcSurfaceKernel.h"
 #include "vtkRGArrays.h"
+#include "vtkRGParallel.h"
 
 #include "vtkCellArray.h"
 #include "vtkDoubleArray.h"
@@ -27,6 +28,32 @@ namespace rgmc
 namespace extract
 {
 
+/// Values per task of the output's fills, on threads that so first touch their pages.
+constexpr vtkIdType FillGrain = 65536;
+
+/// offsets[n] = 3 n for n in [0, numTriangles].
+template <typename T>
+void FillOffsets(T* offsets, vtkIdType numTriangles)
+{
+  rgmc::ParallelFor(numTriangles + 1, FillGrain,
+    [offsets](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType n = begin; n < end; ++n)
+      {
+        offsets[n] = static_cast<T>(3 * n);
+      }
+    });
+}
+
+/// value in every one of n places, on threads.
+template <typename T>
+void Fill(T* values, vtkIdType n, T value)
+{
+  rgmc::ParallelFor(n, FillGrain,
+    [values, value](vtkIdType begin, vtkIdType end)
+    { std::fill(values + begin, values + end, value); });
+}
+
 /// Drops the triangles of the components not kept and numbers the rest with their final ids.
 /// Where this rank keeps every component it has (All Components; Seeded, which grows only what
 /// the seeds reach unless MaximumGrowthRounds was passed), there is nothing to compact: every
@@ -44,10 +71,15 @@ inline void KeepDecidedComponents(
   {
     mesh.Compact(kept);
   }
-  for (std::int32_t& comp : mesh.TriangleComponent)
-  {
-    comp = static_cast<std::int32_t>(decision.FinalId[rootIndex[comp]]);
-  }
+  std::int32_t* comps = mesh.TriangleComponent.data();
+  rgmc::ParallelFor(static_cast<vtkIdType>(mesh.TriangleComponent.size()), FillGrain,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType t = begin; t < end; ++t)
+      {
+        comps[t] = static_cast<std::int32_t>(decision.FinalId[rootIndex[comps[t]]]);
+      }
+    });
 }
 
 inline vtkSmartPointer<vtkPoints> AdoptPoints(
@@ -106,10 +138,7 @@ inline vtkSmartPointer<vtkCellArray> AdoptTriangles(rgmc::LocalMesh& mesh, vtkId
   {
     vtkNew<vtkTypeInt32Array> offsets, connectivity;
     std::int32_t* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-    for (vtkIdType n = 0; n <= numKept; ++n)
-    {
-      o[n] = static_cast<std::int32_t>(3 * n);
-    }
+    FillOffsets(o, numKept);
     connectivity->SetArray(
       mesh.Triangles.Release(), 3 * numKept, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
     polys->SetData(offsets, connectivity);
@@ -118,10 +147,7 @@ inline vtkSmartPointer<vtkCellArray> AdoptTriangles(rgmc::LocalMesh& mesh, vtkId
   {
     vtkNew<vtkTypeInt64Array> offsets, connectivity;
     vtkTypeInt64* o = rgmc::Allocate(offsets.Get(), numKept + 1);
-    for (vtkIdType n = 0; n <= numKept; ++n)
-    {
-      o[n] = 3 * n;
-    }
+    FillOffsets(o, numKept);
     std::copy(mesh.Triangles.begin(), mesh.Triangles.begin() + 3 * numKept,
       rgmc::Allocate(connectivity.Get(), 3 * numKept));
     std::free(mesh.Triangles.Release());

@@ -1001,7 +1001,7 @@ void vtkRGMarchingCubes::AdoptSurface(Run& run, vtkPolyData* output)
     vtkAbstractArray::VTK_DATA_ARRAY_FREE);
   vtkNew<vtkIntArray> rankIds;
   rankIds->SetName("RankId");
-  std::fill_n(rgmc::Allocate(rankIds.Get(), numKept), numKept, run.Ranks.Rank);
+  rgmc::extract::Fill(rgmc::Allocate(rankIds.Get(), numKept), numKept, run.Ranks.Rank);
 
   output->SetPoints(points);
   output->SetPolys(polys);

@@ -139,53 +139,20 @@ public:
 
   /// Makes the triangles of `found` (taken: left empty); fills Mesh, Ports and the components'
   /// triangle counts and smallest keys. The nodes are sorted by slab, slabs are cut into chunks
-  /// of ChunkSlabs, extracted at once (on threads) and joined in chunk order, so that the result
-  /// does not depend on the number of threads.
+  /// of a few slabs, extracted at once (on threads) and joined in chunk order, so that the
+  /// result does not depend on the number of threads.
   void Extract(NodeList& found)
   {
     if (found.empty() || this->Volume.Stopped())
     {
       return;
     }
-    // The box of the nodes' cubes: the slabs and the edge tables cover only it, so that a small
-    // surface costs the same in any volume (no plane-sized tables to touch).
-    CellBox& box = this->NodeBox;
-    for (int a = 0; a < 3; ++a)
-    {
-      box.Lo[a] = std::numeric_limits<int>::max();
-      box.Hi[a] = std::numeric_limits<int>::min();
-    }
-    found.ForEach(
-      [&box](const SurfaceNode& n)
-      {
-        const int c[3] = { n.I, n.J, n.K };
-        for (int a = 0; a < 3; ++a)
-        {
-          box.Lo[a] = std::min(box.Lo[a], c[a]);
-          box.Hi[a] = std::max(box.Hi[a], c[a]);
-        }
-      });
+    this->Volume.Mark("extraction: nodes by slab");
+    Buffer<SurfaceNode> nodes;
+    std::vector<std::int64_t> start, slabTriangles;
+    this->SortBySlab(found, nodes, start, slabTriangles);
+    const CellBox& box = this->NodeBox;
     const int numSlabs = box.Hi[2] - box.Lo[2] + 1;
-
-    // Nodes by slab (a counting sort on k, keeping growth's order within a slab).
-    std::vector<std::int64_t> start(static_cast<std::size_t>(numSlabs) + 1, 0);
-    std::vector<std::int64_t> slabTriangles(static_cast<std::size_t>(numSlabs), 0);
-    found.ForEach(
-      [&](const SurfaceNode& n)
-      {
-        ++start[n.K - box.Lo[2] + 1];
-        slabTriangles[n.K - box.Lo[2]] += this->Volume.Table[n.Case].NumTriangles;
-      });
-    for (int s = 0; s < numSlabs; ++s)
-    {
-      start[s + 1] += start[s];
-    }
-    LargeVector<SurfaceNode> nodes(found.size()); // huge pages: 16 B per node, written at once
-    {
-      std::vector<std::int64_t> next(start.begin(), start.end() - 1);
-      found.ForEach([&](const SurfaceNode& n) { nodes[next[n.K - box.Lo[2]]++] = n; });
-      found.Clear();
-    }
     this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
     for (int e = 0; e < 12; ++e)
     {
@@ -194,25 +161,26 @@ public:
     }
     this->PlaneSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
 
-    const int numChunks = (numSlabs + ChunkSlabs - 1) / ChunkSlabs;
+    this->Volume.Mark("extraction: chunks");
+    // Chunks of a few slabs, all extracted in one parallel step: enough of them for many
+    // threads, few enough that the vertices made twice (on the planes between chunks) cost
+    // little. The chunks depend on the slabs only, never on the threads.
+    const int chunkSlabs = std::max(MinChunkSlabs, std::min(MaxChunkSlabs, numSlabs / 64));
+    const int numChunks = (numSlabs + chunkSlabs - 1) / chunkSlabs;
     std::vector<Chunk> chunks(static_cast<std::size_t>(numChunks));
-    for (int c = 0; c < numChunks && !this->Volume.Stopped(); c += ChunksPerReport)
-    {
-      const int batch = std::min(ChunksPerReport, numChunks - c);
-      this->Volume.Parallel(batch,
-        [&](std::int64_t n)
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t chunk)
+      {
+        const int first = static_cast<int>(chunk) * chunkSlabs;
+        const int last = std::min(numSlabs, first + chunkSlabs);
+        std::int64_t triangles = 0;
+        for (int s = first; s < last; ++s)
         {
-          const int chunk = c + static_cast<int>(n);
-          const int first = chunk * ChunkSlabs, last = std::min(numSlabs, first + ChunkSlabs);
-          std::int64_t triangles = 0;
-          for (int s = first; s < last; ++s)
-          {
-            triangles += slabTriangles[s];
-          }
-          this->ExtractChunk(nodes, start, first, last, triangles, chunks[chunk]);
-        });
-      this->Volume.Report(0.5 + 0.45 * (c + batch) / numChunks);
-    }
+          triangles += slabTriangles[s];
+        }
+        this->ExtractChunk(nodes, start, first, last, triangles, chunks[chunk]);
+      });
+    this->Volume.Report(0.95);
     this->Pool.clear();
     if (this->Volume.Stopped())
     {
@@ -223,9 +191,126 @@ public:
   }
 
 private:
-  static constexpr int ChunkSlabs = 16;     // slabs of cubes per chunk (not per thread)
-  static constexpr int ChunksPerReport = 8; // chunks between progress reports
-  static constexpr int PrefetchAhead = 16;  // nodes between a prefetch and the node's use
+  /// Groups of consecutive blocks of nodes, about equal in nodes: the tasks of SortBySlab. The
+  /// groups depend on the blocks only (never on the threads). Returns the first block of each
+  /// group and, last, the number of blocks.
+  static std::vector<std::size_t> NodeGroups(const NodeList& found)
+  {
+    const std::size_t blocks = found.NumberOfBlocks();
+    const std::size_t wanted = std::max<std::size_t>(1, found.size() / NodesPerGroup);
+    std::vector<std::size_t> first{ 0 };
+    std::size_t seen = 0;
+    for (std::size_t b = 0; b < blocks; ++b)
+    {
+      seen += found.Block(b).size();
+      if (b + 1 < blocks && seen * wanted >= first.size() * found.size())
+      {
+        first.push_back(b + 1);
+      }
+    }
+    first.push_back(blocks);
+    return first;
+  }
+
+  /// The box of the nodes' cubes (NodeBox: the slabs and the edge tables cover only it, so that
+  /// a small surface costs the same in any volume), and the nodes by slab: a counting sort on
+  /// k that keeps growth's order within a slab, in groups of blocks on threads (each group's
+  /// count per slab, then its place in each slab), the same for any number of threads.
+  /// `found` is taken (left empty).
+  void SortBySlab(NodeList& found, Buffer<SurfaceNode>& nodes, std::vector<std::int64_t>& start,
+    std::vector<std::int64_t>& slabTriangles)
+  {
+    const std::vector<std::size_t> groupFirst = NodeGroups(found);
+    const std::int64_t numGroups = static_cast<std::int64_t>(groupFirst.size()) - 1;
+    auto forEachInGroup = [&](std::int64_t g, auto&& f)
+    {
+      for (std::size_t b = groupFirst[g]; b < groupFirst[g + 1]; ++b)
+      {
+        for (const SurfaceNode& n : found.Block(b))
+        {
+          f(n);
+        }
+      }
+    };
+    std::vector<CellBox> boxes(static_cast<std::size_t>(numGroups));
+    this->Volume.Parallel(numGroups,
+      [&](std::int64_t g)
+      {
+        CellBox& gb = boxes[g];
+        for (int a = 0; a < 3; ++a)
+        {
+          gb.Lo[a] = std::numeric_limits<int>::max();
+          gb.Hi[a] = std::numeric_limits<int>::min();
+        }
+        forEachInGroup(g,
+          [&gb](const SurfaceNode& n)
+          {
+            const int c[3] = { n.I, n.J, n.K };
+            for (int a = 0; a < 3; ++a)
+            {
+              gb.Lo[a] = std::min(gb.Lo[a], c[a]);
+              gb.Hi[a] = std::max(gb.Hi[a], c[a]);
+            }
+          });
+      });
+    CellBox& box = this->NodeBox;
+    for (int a = 0; a < 3; ++a)
+    {
+      box.Lo[a] = std::numeric_limits<int>::max();
+      box.Hi[a] = std::numeric_limits<int>::min();
+      for (const CellBox& gb : boxes)
+      {
+        box.Lo[a] = std::min(box.Lo[a], gb.Lo[a]);
+        box.Hi[a] = std::max(box.Hi[a], gb.Hi[a]);
+      }
+    }
+    const std::int64_t numSlabs = box.Hi[2] - box.Lo[2] + 1;
+    // Each group's nodes and triangles per slab, then each group's first place in each slab.
+    std::vector<std::int64_t> place(static_cast<std::size_t>(numGroups * numSlabs), 0);
+    std::vector<std::int64_t> groupTriangles(place.size(), 0);
+    this->Volume.Parallel(numGroups,
+      [&](std::int64_t g)
+      {
+        std::int64_t* count = &place[g * numSlabs];
+        std::int64_t* tris = &groupTriangles[g * numSlabs];
+        forEachInGroup(g,
+          [&](const SurfaceNode& n)
+          {
+            ++count[n.K - box.Lo[2]];
+            tris[n.K - box.Lo[2]] += this->Volume.Table[n.Case].NumTriangles;
+          });
+      });
+    start.assign(static_cast<std::size_t>(numSlabs) + 1, 0);
+    slabTriangles.assign(static_cast<std::size_t>(numSlabs), 0);
+    std::int64_t placed = 0;
+    for (std::int64_t s = 0; s < numSlabs; ++s)
+    {
+      start[s] = placed;
+      for (std::int64_t g = 0; g < numGroups; ++g)
+      {
+        const std::int64_t count = place[g * numSlabs + s];
+        place[g * numSlabs + s] = placed;
+        placed += count;
+        slabTriangles[s] += groupTriangles[g * numSlabs + s];
+      }
+    }
+    start[numSlabs] = placed;
+    // Huge pages, first touched by the threads that fill them: 16 B per node.
+    nodes.resize_for_overwrite(found.size());
+    this->Volume.Parallel(numGroups,
+      [&](std::int64_t g)
+      {
+        std::int64_t* next = &place[g * numSlabs];
+        forEachInGroup(g, [&](const SurfaceNode& n) { nodes[next[n.K - box.Lo[2]]++] = n; });
+      });
+    found.Clear();
+  }
+
+  static constexpr std::size_t NodesPerGroup = 8192; // nodes by slab: nodes per task
+  static constexpr std::int64_t TotalsRange = 65536; // component totals: triangles per task
+  static constexpr int MinChunkSlabs = 4;            // slabs of cubes per chunk (not per thread)
+  static constexpr int MaxChunkSlabs = 16;
+  static constexpr int PrefetchAhead = 16; // nodes between a prefetch and the node's use
 
   /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
   /// reset cheaply).
@@ -306,7 +391,7 @@ private:
     this->Pool.push_back(std::move(work));
   }
 
-  void ExtractChunk(const LargeVector<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
+  void ExtractChunk(const Buffer<SurfaceNode>& nodes, const std::vector<std::int64_t>& start,
     int first, int last, std::int64_t triangles, Chunk& chunk)
   {
     const CellBox& box = this->NodeBox;
@@ -498,12 +583,16 @@ private:
   /// then the components' totals.
   void JoinChunks(std::vector<Chunk>& chunks)
   {
+    this->Volume.Mark("extraction: match planes");
     this->MatchChunkPlanes(chunks);
     std::vector<std::int64_t> vertexBase, triangleBase;
     std::int64_t vertices = 0, triangles = 0;
+    this->Volume.Mark("extraction: number vertices");
     this->NumberJoinedVertices(chunks, vertexBase, triangleBase, vertices, triangles);
     this->CollectChunkPorts(chunks, vertexBase);
+    this->Volume.Mark("extraction: copy chunks");
     this->CopyChunks(chunks, vertexBase, triangleBase, vertices, triangles);
+    this->Volume.Mark("extraction: component totals");
     this->SumComponentTotals();
   }
 
@@ -522,22 +611,19 @@ private:
           return;
         }
         Chunk& below = chunks[c - 1];
-        std::vector<std::pair<std::int64_t, std::int32_t>> theirs;
-        theirs.reserve(below.TopPlane.size());
+        KeyMap theirs(below.TopPlane.size());
         for (std::int32_t id : below.TopPlane)
         {
-          theirs.emplace_back(below.Mesh.Keys[id], id);
+          bool inserted;
+          theirs.FindOrInsert(below.Mesh.Keys[id], id, inserted);
         }
-        std::sort(theirs.begin(), theirs.end());
         for (std::int32_t id : chunk.BottomPlane)
         {
-          const std::int64_t key = chunk.Mesh.Keys[id];
-          auto it =
-            std::lower_bound(theirs.begin(), theirs.end(), std::make_pair(key, std::int32_t(-1)));
-          if (it != theirs.end() && it->first == key)
+          const std::int32_t* match = theirs.Find(chunk.Mesh.Keys[id]);
+          if (match)
           {
-            chunk.FinalId[id] = -1 - it->second; // the chunk below's vertex
-            const int a = below.Mesh.VertexComponent[it->second];
+            chunk.FinalId[id] = -1 - *match; // the chunk below's vertex
+            const int a = below.Mesh.VertexComponent[*match];
             const int b = chunk.Mesh.VertexComponent[id];
             if (a != b)
             {
@@ -554,7 +640,8 @@ private:
   void NumberJoinedVertices(std::vector<Chunk>& chunks, std::vector<std::int64_t>& vertexBase,
     std::vector<std::int64_t>& triangleBase, std::int64_t& vertices, std::int64_t& triangles)
   {
-    vertexBase.resize(chunks.size());
+    const std::int64_t numChunks = static_cast<std::int64_t>(chunks.size());
+    vertexBase.assign(chunks.size(), 0);
     triangleBase.resize(chunks.size());
     for (Chunk& chunk : chunks)
     {
@@ -563,33 +650,57 @@ private:
         this->JoinCount += this->Components.Join(pair.first, pair.second);
       }
       chunk.Joins = std::vector<std::pair<int, int>>();
-      const std::size_t c = static_cast<std::size_t>(&chunk - chunks.data());
+    }
+    // Each chunk's own vertices (FinalId 0) get the next numbers, chunk after chunk.
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t c)
+      {
+        const std::vector<std::int32_t>& ids = chunks[c].FinalId;
+        vertexBase[c] = std::count(ids.begin(), ids.end(), 0);
+      });
+    for (std::int64_t c = 0; c < numChunks; ++c)
+    {
+      const std::int64_t own = vertexBase[c];
       vertexBase[c] = vertices;
       triangleBase[c] = triangles;
-      for (std::int32_t& id : chunk.FinalId)
-      {
-        if (id == 0)
-        {
-          // Vertex ids are 32-bit within a rank.
-          if (vertices >= std::numeric_limits<std::int32_t>::max() - 1)
-          {
-            throw std::length_error("more than 2147483646 surface vertices in one piece");
-          }
-          id = static_cast<std::int32_t>(vertices++);
-        }
-      }
-      triangles += chunk.Mesh.NumberOfTriangles();
+      vertices += own;
+      triangles += chunks[c].Mesh.NumberOfTriangles();
     }
-    for (std::size_t c = 1; c < chunks.size(); ++c)
+    // Vertex ids are 32-bit within a rank.
+    if (vertices > std::numeric_limits<std::int32_t>::max() - 1)
     {
-      for (std::int32_t& id : chunks[c].FinalId)
-      {
-        if (id < 0)
-        {
-          id = chunks[c - 1].FinalId[-1 - id];
-        }
-      }
+      throw std::length_error("more than 2147483646 surface vertices in one piece");
     }
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t c)
+      {
+        std::int32_t next = static_cast<std::int32_t>(vertexBase[c]);
+        for (std::int32_t& id : chunks[c].FinalId)
+        {
+          if (id == 0)
+          {
+            id = next++;
+          }
+        }
+      });
+    // A vertex the chunk below made is one of that chunk's own (on its top plane, never on its
+    // bottom one): numbered above, and not written here.
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t c)
+      {
+        if (c == 0)
+        {
+          return;
+        }
+        const std::vector<std::int32_t>& below = chunks[c - 1].FinalId;
+        for (std::int32_t& id : chunks[c].FinalId)
+        {
+          if (id < 0)
+          {
+            id = below[-1 - id];
+          }
+        }
+      });
   }
 
   /// The ports of the joined mesh: each chunk's, on its own vertices.
@@ -725,21 +836,57 @@ private:
     }
   }
 
-  /// The components' totals: triangles and smallest key, on their roots.
+  /// The components' totals: triangles and smallest key, on their roots. Ranges of triangles
+  /// and vertices on threads, each a list of runs of one root (few: neighbours mostly share a
+  /// component), added up in range order (sums and minima: the same for any threads).
   void SumComponentTotals()
   {
     const LocalMesh& m = this->Mesh;
-    const std::size_t nt = static_cast<std::size_t>(m.NumberOfTriangles());
-    const std::size_t nv = static_cast<std::size_t>(m.NumberOfPoints());
-    for (std::size_t t = 0; t < nt; ++t)
+    const std::int64_t nt = m.NumberOfTriangles();
+    const std::int64_t nv = m.NumberOfPoints();
+    std::vector<int> roots(static_cast<std::size_t>(this->Components.Size()));
+    for (std::size_t c = 0; c < roots.size(); ++c)
     {
-      ++this->Components.TotalsOf(this->Components.Root(m.TriangleComponent[t])).Triangles;
+      roots[c] = this->Components.Root(static_cast<int>(c));
     }
-    for (std::size_t v = 0; v < nv; ++v)
+    struct Run
     {
-      ComponentSet::Totals& totals =
-        this->Components.TotalsOf(this->Components.Root(m.VertexComponent[v]));
-      totals.MinKey = std::min<std::int64_t>(totals.MinKey, m.Keys[v]);
+      int Root;
+      std::int64_t Triangles;
+      std::int64_t MinKey;
+    };
+    const std::int64_t numRanges = std::max<std::int64_t>(1, (nt + TotalsRange - 1) / TotalsRange);
+    std::vector<std::vector<Run>> runs(static_cast<std::size_t>(numRanges));
+    this->Volume.Parallel(numRanges,
+      [&](std::int64_t r)
+      {
+        std::vector<Run>& out = runs[r];
+        auto runOf = [&out](int root) -> Run&
+        {
+          if (out.empty() || out.back().Root != root)
+          {
+            out.push_back(Run{ root, 0, std::numeric_limits<std::int64_t>::max() });
+          }
+          return out.back();
+        };
+        for (std::int64_t t = nt * r / numRanges; t < nt * (r + 1) / numRanges; ++t)
+        {
+          ++runOf(roots[m.TriangleComponent[t]]).Triangles;
+        }
+        for (std::int64_t v = nv * r / numRanges; v < nv * (r + 1) / numRanges; ++v)
+        {
+          Run& run = runOf(roots[m.VertexComponent[v]]);
+          run.MinKey = std::min<std::int64_t>(run.MinKey, m.Keys[v]);
+        }
+      });
+    for (const std::vector<Run>& list : runs)
+    {
+      for (const Run& run : list)
+      {
+        ComponentSet::Totals& totals = this->Components.TotalsOf(run.Root);
+        totals.Triangles += run.Triangles;
+        totals.MinKey = std::min(totals.MinKey, run.MinKey);
+      }
     }
   }
 
