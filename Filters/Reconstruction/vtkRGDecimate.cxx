@@ -363,7 +363,6 @@ int vtkRGDecimate::RequestData(
   };
 
   // PASS 0-1: a numbered triangle mesh, read in place.
-  rgmc::SpanMark("read surface");
   if (!this->CheckInput(run) || !this->ReadSurface(run))
   {
     return fail();
@@ -372,20 +371,13 @@ int vtkRGDecimate::RequestData(
   for (int pass = 0; pass < MaximumPasses && run.Triangles > run.Target; ++pass)
   {
     // PASS 2-7: one pass of block simplification, its blocks made and simplified in waves.
-    rgmc::SpanMark("place blocks");
     if (!this->PlaceBlocks(run, pass) || !this->FindSharedVertices(run))
     {
       return fail();
     }
     for (int wave = 0; wave < run.Waves; ++wave)
     {
-      rgmc::SpanMark("send triangles");
-      if (!this->SendTriangles(run, wave))
-      {
-        return fail();
-      }
-      rgmc::SpanMark("simplify blocks");
-      if (!this->SimplifyBlocks(run, wave))
+      if (!this->SendTriangles(run, wave) || !this->SimplifyBlocks(run, wave))
       {
         return fail();
       }
@@ -394,7 +386,6 @@ int vtkRGDecimate::RequestData(
         ReleaseFreeMemory(); // the wave's meshes and messages
       }
     }
-    rgmc::SpanMark("keep cheapest, apply collapses");
     if (!this->KeepCheapest(run, pass >= AllFromPass) || !this->ApplyCollapses(run))
     {
       return fail();
@@ -410,7 +401,6 @@ int vtkRGDecimate::RequestData(
     }
   }
   // PASS 8: one mesh again, with normals, checks and measures.
-  rgmc::SpanMark("decimated piece");
   if (!this->NumberSurface(run, output))
   {
     return fail();
@@ -430,6 +420,7 @@ int vtkRGDecimate::RequestData(
 //------------------------------------------------------------------------------
 bool vtkRGDecimate::CheckInput(Run& run)
 {
+  rgmc::SpanMark("read surface");
   vtkPolyData* input = run.Input;
   std::ostringstream problem;
   if (!(this->TargetReduction > 0.0 && this->TargetReduction < 1.0))
@@ -540,6 +531,7 @@ void vtkRGDecimate::ReadPartBounds(Run& run, double bounds[6])
 // offset), the triangles of each block over all ranks, the blocks' ranks and waves.
 bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
 {
+  rgmc::SpanMark("place blocks");
   BlockGrid& grid = run.Grid;
   double longest = 0;
   for (int a = 0; a < 3; ++a)
@@ -797,6 +789,7 @@ void vtkRGDecimate::RecordSharedVertices(Run& run, const Messages& told)
 // vertices' records; then each block's mesh in local indices.
 bool vtkRGDecimate::SendTriangles(Run& run, int wave)
 {
+  rgmc::SpanMark("send triangles");
   const int size = run.Ranks.Size;
   Messages outgoing(static_cast<std::size_t>(size));
   if (!run.Ranks.Step("send the triangles to their blocks", run.Problem,
@@ -889,6 +882,7 @@ void vtkRGDecimate::AssembleBlocks(Run& run, int wave, Messages& incoming)
 // levels are kept: ApplyCollapses makes the blocks again.
 bool vtkRGDecimate::SimplifyBlocks(Run& run, int wave)
 {
+  rgmc::SpanMark("simplify blocks");
   const double maximumError = this->MaximumError;
   // No block needs more collapses than the whole surface still needs; and a block is stopped at
   // four times its share of them (a rule of global counts only, so the same on any ranks): the
@@ -919,6 +913,7 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run, int wave)
 // error so far in their block), ties by block and order.
 bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
 {
+  rgmc::SpanMark("keep cheapest, apply collapses");
   // Collapses found, and the blocks' vertices, fixed or not.
   vtkIdType local[3] = { 0, 0, 0 }, sums[3] = { 0, 0, 0 };
   for (const Block& block : run.Blocks)
@@ -1081,6 +1076,7 @@ bool vtkRGDecimate::ApplyCollapses(Run& run)
 // measures.
 bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
 {
+  rgmc::SpanMark("decimated piece");
   vtkNew<vtkPolyData> piece;
   if (!run.Ranks.Step(
         "build the decimated piece", run.Problem, [&]() { this->BuildDecimatedPiece(run, piece); }))

@@ -8,6 +8,7 @@
 
 #include "rgmcBuffer.h"
 #include "rgmcKeyMap.h"
+#include "rgmcNodesBySlab.h"
 #include "rgmcSampledVolume.h"
 
 #include <algorithm>
@@ -148,9 +149,15 @@ public:
       return;
     }
     this->Volume.Mark("extraction: nodes by slab");
-    Buffer<SurfaceNode> nodes;
-    std::vector<std::int64_t> start, slabTriangles;
-    this->SortBySlab(found, nodes, start, slabTriangles);
+    NodesBySlab sorted;
+    SortNodesBySlab(
+      found, this->Volume.Table, NodesPerGroup,
+      [this](std::int64_t count, auto&& task) { this->Volume.Parallel(count, task); }, sorted);
+    found.Clear();
+    this->NodeBox = sorted.Box;
+    const Buffer<SurfaceNode>& nodes = sorted.Nodes;
+    const std::vector<std::int64_t>& start = sorted.Start;
+    const std::vector<std::int64_t>& slabTriangles = sorted.SlabTriangles;
     const CellBox& box = this->NodeBox;
     const int numSlabs = box.Hi[2] - box.Lo[2] + 1;
     this->LayerNx = box.Hi[0] - box.Lo[0] + 2;
@@ -191,121 +198,6 @@ public:
   }
 
 private:
-  /// Groups of consecutive blocks of nodes, about equal in nodes: the tasks of SortBySlab. The
-  /// groups depend on the blocks only (never on the threads). Returns the first block of each
-  /// group and, last, the number of blocks.
-  static std::vector<std::size_t> NodeGroups(const NodeList& found)
-  {
-    const std::size_t blocks = found.NumberOfBlocks();
-    const std::size_t wanted = std::max<std::size_t>(1, found.size() / NodesPerGroup);
-    std::vector<std::size_t> first{ 0 };
-    std::size_t seen = 0;
-    for (std::size_t b = 0; b < blocks; ++b)
-    {
-      seen += found.Block(b).size();
-      if (b + 1 < blocks && seen * wanted >= first.size() * found.size())
-      {
-        first.push_back(b + 1);
-      }
-    }
-    first.push_back(blocks);
-    return first;
-  }
-
-  /// The box of the nodes' cubes (NodeBox: the slabs and the edge tables cover only it, so that
-  /// a small surface costs the same in any volume), and the nodes by slab: a counting sort on
-  /// k that keeps growth's order within a slab, in groups of blocks on threads (each group's
-  /// count per slab, then its place in each slab), the same for any number of threads.
-  /// `found` is taken (left empty).
-  void SortBySlab(NodeList& found, Buffer<SurfaceNode>& nodes, std::vector<std::int64_t>& start,
-    std::vector<std::int64_t>& slabTriangles)
-  {
-    const std::vector<std::size_t> groupFirst = NodeGroups(found);
-    const std::int64_t numGroups = static_cast<std::int64_t>(groupFirst.size()) - 1;
-    auto forEachInGroup = [&](std::int64_t g, auto&& f)
-    {
-      for (std::size_t b = groupFirst[g]; b < groupFirst[g + 1]; ++b)
-      {
-        for (const SurfaceNode& n : found.Block(b))
-        {
-          f(n);
-        }
-      }
-    };
-    std::vector<CellBox> boxes(static_cast<std::size_t>(numGroups));
-    this->Volume.Parallel(numGroups,
-      [&](std::int64_t g)
-      {
-        CellBox& gb = boxes[g];
-        for (int a = 0; a < 3; ++a)
-        {
-          gb.Lo[a] = std::numeric_limits<int>::max();
-          gb.Hi[a] = std::numeric_limits<int>::min();
-        }
-        forEachInGroup(g,
-          [&gb](const SurfaceNode& n)
-          {
-            const int c[3] = { n.I, n.J, n.K };
-            for (int a = 0; a < 3; ++a)
-            {
-              gb.Lo[a] = std::min(gb.Lo[a], c[a]);
-              gb.Hi[a] = std::max(gb.Hi[a], c[a]);
-            }
-          });
-      });
-    CellBox& box = this->NodeBox;
-    for (int a = 0; a < 3; ++a)
-    {
-      box.Lo[a] = std::numeric_limits<int>::max();
-      box.Hi[a] = std::numeric_limits<int>::min();
-      for (const CellBox& gb : boxes)
-      {
-        box.Lo[a] = std::min(box.Lo[a], gb.Lo[a]);
-        box.Hi[a] = std::max(box.Hi[a], gb.Hi[a]);
-      }
-    }
-    const std::int64_t numSlabs = box.Hi[2] - box.Lo[2] + 1;
-    // Each group's nodes and triangles per slab, then each group's first place in each slab.
-    std::vector<std::int64_t> place(static_cast<std::size_t>(numGroups * numSlabs), 0);
-    std::vector<std::int64_t> groupTriangles(place.size(), 0);
-    this->Volume.Parallel(numGroups,
-      [&](std::int64_t g)
-      {
-        std::int64_t* count = &place[g * numSlabs];
-        std::int64_t* tris = &groupTriangles[g * numSlabs];
-        forEachInGroup(g,
-          [&](const SurfaceNode& n)
-          {
-            ++count[n.K - box.Lo[2]];
-            tris[n.K - box.Lo[2]] += this->Volume.Table[n.Case].NumTriangles;
-          });
-      });
-    start.assign(static_cast<std::size_t>(numSlabs) + 1, 0);
-    slabTriangles.assign(static_cast<std::size_t>(numSlabs), 0);
-    std::int64_t placed = 0;
-    for (std::int64_t s = 0; s < numSlabs; ++s)
-    {
-      start[s] = placed;
-      for (std::int64_t g = 0; g < numGroups; ++g)
-      {
-        const std::int64_t count = place[g * numSlabs + s];
-        place[g * numSlabs + s] = placed;
-        placed += count;
-        slabTriangles[s] += groupTriangles[g * numSlabs + s];
-      }
-    }
-    start[numSlabs] = placed;
-    // Huge pages, first touched by the threads that fill them: 16 B per node.
-    nodes.resize_for_overwrite(found.size());
-    this->Volume.Parallel(numGroups,
-      [&](std::int64_t g)
-      {
-        std::int64_t* next = &place[g * numSlabs];
-        forEachInGroup(g, [&](const SurfaceNode& n) { nodes[next[n.K - box.Lo[2]]++] = n; });
-      });
-    found.Clear();
-  }
-
   static constexpr std::size_t NodesPerGroup = 8192; // nodes by slab: nodes per task
   static constexpr std::int64_t TotalsRange = 65536; // component totals: triangles per task
   static constexpr int MinChunkSlabs = 4;            // slabs of cubes per chunk (not per thread)
