@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <exception>
 #include <mutex>
 #include <vector>
@@ -66,6 +67,24 @@ void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
     std::rethrow_exception(failure);
   }
 }
+
+/// The kernels' parallel(count, task) (rgmc::RadixSort's, for one): task(i) for every i in
+/// [0, count), one index a task, on vtkSMPTools' threads through ParallelFor.
+struct Tasks
+{
+  template <typename Task>
+  void operator()(std::int64_t count, Task&& task) const
+  {
+    ParallelFor(static_cast<vtkIdType>(count), 1,
+      [&task](vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          task(i);
+        }
+      });
+  }
+};
 
 /// Sorts [begin, end) on threads: fixed slices (not one per thread) sorted at once, then merged
 /// pairwise in rounds. The elements must be totally ordered (no two equal), so that the result

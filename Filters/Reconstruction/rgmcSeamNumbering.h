@@ -86,16 +86,22 @@ rgmc::LargeVector<IdentifiedPoint<Words>> SortByIdentity(vtkPolyData* input, con
   // One-word identities (the keys) are sorted packed with their points, one word each, where
   // both fit in 64 bits: a key takes log2 of 4 x the grid points (edge keys, then point keys), an
   // index log2 of the points (a 2048^3 volume leaves room for 500 million points).
+  // The parallel sorts count each pass's digits per range before moving them: about 1.5 to 2
+  // times the serial sorts' work, which pays from 4 threads (on 2, Seam Repair took 1-2% longer
+  // with them). The result is the same either way; the work/span profile takes them.
+  const bool threads =
+    rgmc::SpanRecorder::Recording() || vtkSMPTools::GetEstimatedNumberOfThreads() >= 4;
   bool packed = false;
   if constexpr (Words == 1)
   {
-    packed = rgmc::RadixSortPacked(
-      static_cast<std::size_t>(n), [keys](std::size_t p) { return BitsOfWord(keys[p]); },
-      [&all](std::size_t r, std::uint64_t key, std::size_t p)
-      {
-        all[r].first[0] = key;
-        all[r].second = static_cast<vtkIdType>(p);
-      });
+    auto keyAt = [keys](std::size_t p) { return BitsOfWord(keys[p]); };
+    auto put = [&all](std::size_t r, std::uint64_t key, std::size_t p)
+    {
+      all[r].first[0] = key;
+      all[r].second = static_cast<vtkIdType>(p);
+    };
+    packed = threads ? rgmc::RadixSortPacked(static_cast<std::size_t>(n), keyAt, put, rgmc::Tasks())
+                     : rgmc::RadixSortPacked(static_cast<std::size_t>(n), keyAt, put);
   }
   for (vtkIdType p = 0; p < n && !packed; ++p)
   {
@@ -119,9 +125,14 @@ rgmc::LargeVector<IdentifiedPoint<Words>> SortByIdentity(vtkPolyData* input, con
   // points come in increasing order, so its stable order is the pairs' order.
   if constexpr (Words == 1)
   {
-    if (!packed)
+    auto keyOf = [](const IdentifiedPoint<Words>& entry) { return entry.first[0]; };
+    if (!packed && threads)
     {
-      rgmc::RadixSort(all, [](const IdentifiedPoint<Words>& entry) { return entry.first[0]; });
+      rgmc::RadixSort(all, keyOf, rgmc::Tasks());
+    }
+    else if (!packed)
+    {
+      rgmc::RadixSort(all, keyOf);
     }
   }
   else
@@ -174,8 +185,12 @@ template <int Words>
 LocalVertices MergeLocal(
   vtkPolyData* input, const vtkIdType* keys, std::vector<Identity<Words>>& ids)
 {
+  rgmc::SpanMark("numbering: sort");
   const rgmc::LargeVector<IdentifiedPoint<Words>> all = SortByIdentity<Words>(input, keys);
-  return DistinctVertices<Words>(all, input->GetNumberOfPoints(), ids);
+  rgmc::SpanMark("numbering: distinct vertices");
+  LocalVertices local = DistinctVertices<Words>(all, input->GetNumberOfPoints(), ids);
+  rgmc::SpanMark("numbering: global ids");
+  return local;
 }
 
 /// The global id and owner of each of this rank's vertices, and the other holders of the shared

@@ -1,13 +1,16 @@
 // Unit test of rgmc::RadixSort and rgmc::RadixSortPacked against std::sort: (key, index) records
 // come out as std::sort on the pairs gives them, for keys that differ in few or many bytes, with
 // many equal keys, and for keys whose top bits are set (unsigned order); the packed sort runs
-// exactly when every key fits above the indices' bits.
+// exactly when every key fits above the indices' bits; on tasks (ranges of 65 536 values) run
+// in reverse order and on threads, the same.
 #include "rgmcCheck.h"
 #include "rgmcRadixSort.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <random>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -43,6 +46,56 @@ void Check(const std::vector<std::uint64_t>& keys, const char* what)
     what << ": " << keys.size() << " keys " << (fits ? "fit" : "do not fit") << " above "
          << indexBits << " index bits, but the packed sort " << (done ? "ran" : "refused"));
   RGMC_CHECK(!done || packed == expected, what << ": " << keys.size() << " keys, packed");
+
+  // On tasks, run in reverse order and on 4 threads: the same records in the same order.
+  for (int mode = 0; mode < 2; ++mode)
+  {
+    auto parallel = [mode](std::int64_t count, auto&& task)
+    {
+      if (mode == 0)
+      {
+        for (std::int64_t i = count - 1; i >= 0; --i)
+        {
+          task(i);
+        }
+        return;
+      }
+      std::atomic<std::int64_t> next{ 0 };
+      std::vector<std::thread> threads;
+      for (int t = 0; t < 4; ++t)
+      {
+        threads.emplace_back(
+          [&]()
+          {
+            for (std::int64_t i = next++; i < count; i = next++)
+            {
+              task(i);
+            }
+          });
+      }
+      for (std::thread& t : threads)
+      {
+        t.join();
+      }
+    };
+    const char* how = mode == 0 ? "tasks reversed" : "tasks on threads";
+    std::vector<Record> onTasks(keys.size());
+    for (std::size_t i = 0; i < keys.size(); ++i)
+    {
+      onTasks[i] = Record(keys[i], static_cast<std::int64_t>(i));
+    }
+    rgmc::RadixSort(
+      onTasks, [](const Record& r) { return r.first; }, parallel);
+    RGMC_CHECK(onTasks == expected, what << ", " << how << ": " << keys.size() << " keys");
+    std::vector<Record> packedOnTasks(keys.size(), Record(0, -1));
+    const bool doneOnTasks = rgmc::RadixSortPacked(
+      keys.size(), [&keys](std::size_t i) { return keys[i]; },
+      [&packedOnTasks](std::size_t r, std::uint64_t key, std::size_t i)
+      { packedOnTasks[r] = Record(key, static_cast<std::int64_t>(i)); },
+      parallel);
+    RGMC_CHECK(doneOnTasks == fits && (!doneOnTasks || packedOnTasks == expected),
+      what << ", " << how << ": " << keys.size() << " keys, packed");
+  }
 }
 
 } // namespace
@@ -53,7 +106,7 @@ int main()
   Check({}, "empty");
   Check({ 7 }, "one key");
   Check({ 5, 5, 5, 5 }, "all equal");
-  for (std::size_t n : { 2, 3, 255, 256, 257, 10000, 300000 })
+  for (std::size_t n : { 2, 3, 255, 256, 257, 10000, 65536, 65537, 300000 })
   {
     std::vector<std::uint64_t> keys(n);
     // Vertex-key-like: 30 significant bits, the upper bytes the same.

@@ -1,11 +1,13 @@
 // Threads in the tests: a test run with `--threads N` updates the project's filters under
 // vtkSMPTools with the STDThread backend and N threads, and also with 1 thread, and checks that
-// the two outputs are bitwise identical (every array of the output, in order); its own checks
-// then run on the N-thread output. Without --threads, filters update as configured.
+// the two outputs are bitwise identical (every array of the output, in order), as is the output
+// of a run under the work/span profile (vtkRGSpan.h); its own checks then run on the N-thread
+// output. Without --threads, filters update as configured.
 #ifndef rgmcThreadCompare_h
 #define rgmcThreadCompare_h
 
 #include "rgmcCheck.h"
+#include "vtkRGSpan.h"
 
 #include "vtkAbstractArray.h"
 #include "vtkAlgorithm.h"
@@ -153,6 +155,24 @@ inline void UpdateAtThreads(
       single.TakeReference(algorithm->GetOutputDataObject(0)->NewInstance());
       single->DeepCopy(algorithm->GetOutputDataObject(0));
     });
+  // The work/span profile's run takes the paths of several threads, its tasks one by one: the
+  // same output, so that the profile measures the computation the threads do.
+  vtkSMPTools::LocalScope(vtkSMPTools::Config{ 1, "STDThread", false },
+    [&]()
+    {
+      if (between)
+      {
+        between();
+      }
+      rgmc::SpanRecorder recorder;
+      ModifiedUpstream(algorithm);
+      recorder.Start();
+      algorithm->Update();
+      recorder.Stop();
+    });
+  const std::string profiled = Difference(single, algorithm->GetOutputDataObject(0));
+  RGMC_CHECK(profiled.empty(),
+    what << ": " << profiled << " differ between 1 thread and the work/span profile's run");
   if (between)
   {
     between();
