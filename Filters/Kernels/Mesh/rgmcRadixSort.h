@@ -89,40 +89,31 @@ struct SerialTasks
 /// Values per task of the parallel sorts (fixed: the ranges never depend on the threads).
 constexpr std::size_t RadixRange = 65536;
 
-/// RadixSort on tasks: parallel(count, task) runs task(i) for every i in [0, count), in any
-/// order, possibly at once. Per byte pass, each range of RadixRange values counts its digits,
-/// then scatters them after the same digit of the ranges before it: stable, so the result is
-/// exactly RadixSort's.
-template <typename Vector, typename KeyOf, typename Parallel>
-void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
+/// The ranges of the parallel radix sort's tasks over n values.
+struct RadixRanges
 {
-  using T = typename Vector::value_type;
-  using Counts = std::array<std::size_t, 256>;
-  const std::size_t n = values.size();
-  const std::size_t ranges = (n + RadixRange - 1) / RadixRange;
-  if (ranges < 2 || std::is_same<typename std::decay<Parallel>::type, SerialTasks>::value)
-  {
-    RadixSort(values, keyOf); // one range, or no threads: without the per-pass counts
-    return;
-  }
-  auto range = [n, ranges](std::size_t r, std::size_t& begin, std::size_t& end)
-  {
-    begin = n * r / ranges;
-    end = n * (r + 1) / ranges;
-  };
-  // Which bytes differ among the keys: every byte's histogram, per range, summed.
-  std::vector<std::array<Counts, 8>> all(ranges);
-  parallel(static_cast<std::int64_t>(ranges),
+  std::size_t N, Count;
+  std::size_t Begin(std::size_t r) const { return this->N * r / this->Count; }
+  std::size_t End(std::size_t r) const { return this->N * (r + 1) / this->Count; }
+};
+
+using RadixCounts = std::array<std::size_t, 256>;
+
+/// Every byte's histogram of the keys of each range.
+template <typename Vector, typename KeyOf, typename Parallel>
+std::vector<std::array<RadixCounts, 8>> RadixHistograms(
+  const Vector& values, KeyOf& keyOf, Parallel& parallel, const RadixRanges& ranges)
+{
+  std::vector<std::array<RadixCounts, 8>> all(ranges.Count);
+  parallel(static_cast<std::int64_t>(ranges.Count),
     [&](std::int64_t r)
     {
-      std::array<Counts, 8>& c = all[r];
-      for (Counts& byte : c)
+      std::array<RadixCounts, 8>& c = all[r];
+      for (RadixCounts& byte : c)
       {
         byte.fill(0);
       }
-      std::size_t begin, end;
-      range(static_cast<std::size_t>(r), begin, end);
-      for (std::size_t i = begin; i < end; ++i)
+      for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
       {
         const std::uint64_t key = keyOf(values[i]);
         for (int b = 0; b < 8; ++b)
@@ -131,16 +122,77 @@ void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
         }
       }
     });
+  return all;
+}
+
+/// One stable pass on byte b from `from` to `to`: each range's digits (`place`, counted already
+/// when `counted`), then each range's first place for each digit, then the scatter.
+template <typename Vector, typename KeyOf, typename Parallel>
+void RadixPass(const Vector& from, Vector& to, int b, KeyOf& keyOf, Parallel& parallel,
+  const RadixRanges& ranges, std::vector<RadixCounts>& place, bool counted)
+{
+  auto digit = [&keyOf, b](const typename Vector::value_type& v)
+  { return (keyOf(v) >> (8 * b)) & 0xff; };
+  if (!counted)
+  {
+    parallel(static_cast<std::int64_t>(ranges.Count),
+      [&](std::int64_t r)
+      {
+        place[r].fill(0);
+        for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
+        {
+          ++place[r][digit(from[i])];
+        }
+      });
+  }
+  std::size_t start = 0;
+  for (int d = 0; d < 256; ++d)
+  {
+    for (RadixCounts& c : place)
+    {
+      const std::size_t here = c[d];
+      c[d] = start;
+      start += here;
+    }
+  }
+  parallel(static_cast<std::int64_t>(ranges.Count),
+    [&](std::int64_t r)
+    {
+      RadixCounts& next = place[r];
+      for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
+      {
+        to[next[digit(from[i])]++] = from[i];
+      }
+    });
+}
+
+/// RadixSort on tasks: parallel(count, task) runs task(i) for every i in [0, count), in any
+/// order, possibly at once. Per byte pass, each range of RadixRange values counts its digits
+/// (the histograms' own before the first pass moved anything), then scatters them after the
+/// same digit of the ranges before it: stable, so the result is exactly RadixSort's.
+template <typename Vector, typename KeyOf, typename Parallel>
+void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
+{
+  const std::size_t n = values.size();
+  const RadixRanges ranges{ n, (n + RadixRange - 1) / RadixRange };
+  if (ranges.Count < 2 || std::is_same<typename std::decay<Parallel>::type, SerialTasks>::value)
+  {
+    RadixSort(values, keyOf); // one range, or no threads: without the per-pass counts
+    return;
+  }
+  // Which bytes differ among the keys: the histograms, summed.
+  const std::vector<std::array<RadixCounts, 8>> all =
+    RadixHistograms(values, keyOf, parallel, ranges);
   Vector buffer(n);
   Vector* from = &values;
   Vector* to = &buffer;
-  std::vector<Counts> place(ranges);
+  std::vector<RadixCounts> place(ranges.Count);
   bool moved = false; // a pass has moved the values
   for (int b = 0; b < 8; ++b)
   {
     const std::uint64_t first = (keyOf(values[0]) >> (8 * b)) & 0xff;
     std::size_t same = 0;
-    for (const std::array<Counts, 8>& c : all)
+    for (const std::array<RadixCounts, 8>& c : all)
     {
       same += c[b][first];
     }
@@ -148,47 +200,14 @@ void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
     {
       continue; // every key has this byte
     }
-    // This pass's digits per range of the current order (the histograms' own before the first
-    // pass moved anything), then each range's first place.
-    parallel(static_cast<std::int64_t>(ranges),
-      [&](std::int64_t r)
-      {
-        Counts& c = place[r];
-        if (!moved)
-        {
-          c = all[r][b];
-          return;
-        }
-        c.fill(0);
-        std::size_t begin, end;
-        range(static_cast<std::size_t>(r), begin, end);
-        for (std::size_t i = begin; i < end; ++i)
-        {
-          ++c[(keyOf((*from)[i]) >> (8 * b)) & 0xff];
-        }
-      });
-    std::size_t start = 0;
-    for (int d = 0; d < 256; ++d)
+    if (!moved)
     {
-      for (Counts& c : place)
+      for (std::size_t r = 0; r < ranges.Count; ++r)
       {
-        const std::size_t here = c[d];
-        c[d] = start;
-        start += here;
+        place[r] = all[r][b];
       }
     }
-    parallel(static_cast<std::int64_t>(ranges),
-      [&](std::int64_t r)
-      {
-        Counts& next = place[r];
-        std::size_t begin, end;
-        range(static_cast<std::size_t>(r), begin, end);
-        for (std::size_t i = begin; i < end; ++i)
-        {
-          const T& v = (*from)[i];
-          (*to)[next[(keyOf(v) >> (8 * b)) & 0xff]++] = v;
-        }
-      });
+    RadixPass(*from, *to, b, keyOf, parallel, ranges, place, !moved);
     std::swap(from, to);
     moved = true;
   }
