@@ -56,6 +56,18 @@ struct LocalMesh
     }
   }
 
+  /// Frees every array now, pages first (Buffer::FreeNow).
+  void FreeNow()
+  {
+    this->Points.FreeNow();
+    this->PointsDouble.FreeNow();
+    this->Normals.FreeNow();
+    this->Keys.FreeNow();
+    this->VertexComponent.FreeNow();
+    this->Triangles.FreeNow();
+    this->TriangleComponent.FreeNow();
+  }
+
   /// Keeps the triangles whose component `keep(component)` accepts and the points they use,
   /// in their order, in place.
   template <typename Keep>
@@ -172,7 +184,7 @@ public:
     // Chunks of a few slabs, all extracted in one parallel step: enough of them for many
     // threads, few enough that the vertices made twice (on the planes between chunks) cost
     // little. The chunks depend on the slabs only, never on the threads.
-    const int chunkSlabs = std::max(MinChunkSlabs, std::min(MaxChunkSlabs, numSlabs / 64));
+    const int chunkSlabs = std::max(MinChunkSlabs, std::min(MaxChunkSlabs, numSlabs / 32));
     const int numChunks = (numSlabs + chunkSlabs - 1) / chunkSlabs;
     std::vector<Chunk> chunks(static_cast<std::size_t>(numChunks));
     this->Volume.Parallel(numChunks,
@@ -692,6 +704,9 @@ private:
           }
           m.TriangleComponent[t0 + t] = from.TriangleComponent[t];
         }
+        // The chunk's memory back as the joined mesh's fills, not after the last chunk.
+        chunk.Mesh.FreeNow();
+        DiscardPages(chunk.FinalId.data(), chunk.FinalId.size() * sizeof(std::int32_t));
         chunk = Chunk();
       });
   }

@@ -27,14 +27,17 @@ struct NodesBySlab
   std::vector<std::int64_t> SlabTriangles;
 };
 
-/// Groups of consecutive blocks of `found`, about `nodesPerGroup` nodes each: the tasks of
-/// SortNodesBySlab. They depend on the blocks only, never on the threads. Returns each group's
-/// first block and, last, the number of blocks.
+/// The most groups of SortNodesBySlab: their counts per slab are 16 bytes a group and slab.
+constexpr std::size_t MaxNodeGroups = 256;
+
+/// Groups of consecutive blocks of `found`, about `nodesPerGroup` nodes each (at most
+/// MaxNodeGroups groups): the tasks of SortNodesBySlab. They depend on the blocks only, never on
+/// the threads. Returns each group's first block and, last, the number of blocks.
 inline std::vector<std::size_t> NodeGroups(const NodeList& found, std::size_t nodesPerGroup)
 {
   const std::size_t blocks = found.NumberOfBlocks();
-  const std::size_t wanted =
-    std::max<std::size_t>(1, found.size() / std::max<std::size_t>(1, nodesPerGroup));
+  const std::size_t wanted = std::min<std::size_t>(MaxNodeGroups,
+    std::max<std::size_t>(1, found.size() / std::max<std::size_t>(1, nodesPerGroup)));
   std::vector<std::size_t> first{ 0 };
   std::size_t seen = 0;
   for (std::size_t b = 0; b < blocks; ++b)
