@@ -103,12 +103,13 @@ Timed Measure(Algorithm* algorithm, int threads, int repeats)
   return best;
 }
 
-/// The stage's phases on one thread under a recorder: those of the run with the least work.
+/// The stage's phases on one thread under a recorder, and their sum (`total`): those of the run
+/// with the least work.
 template <typename Algorithm>
-std::vector<rgmc::SpanPhase> Profile(Algorithm* algorithm, int repeats)
+std::vector<rgmc::SpanPhase> Profile(Algorithm* algorithm, int repeats, rgmc::SpanPhase& total)
 {
   std::vector<rgmc::SpanPhase> best;
-  double least = 1e300;
+  total.Work = 1e300;
   vtkSMPTools::LocalScope(vtkSMPTools::Config{ 1, "STDThread", false },
     [&]()
     {
@@ -119,10 +120,10 @@ std::vector<rgmc::SpanPhase> Profile(Algorithm* algorithm, int repeats)
         recorder.Start();
         algorithm->Update();
         recorder.Stop();
-        const double work = recorder.Total("").Work;
-        if (work < least)
+        const rgmc::SpanPhase sum = recorder.Total("total");
+        if (sum.Work < total.Work)
         {
-          least = work;
+          total = sum;
           best = recorder.Phases();
         }
       }
@@ -145,16 +146,8 @@ std::string Stage(const std::string& volume, const std::string& stage, Algorithm
   const Timed one = Measure(algorithm, 1, repeats);
   const Timed two = Measure(algorithm, 2, repeats);
   const long long triangles = algorithm->GetOutput()->GetNumberOfCells();
-  std::vector<rgmc::SpanPhase> phases = Profile(algorithm, repeats);
-  rgmc::SpanPhase total{ "total" };
-  for (const rgmc::SpanPhase& p : phases)
-  {
-    total.Work += p.Work;
-    total.ParallelWork += p.ParallelWork;
-    total.LongestTasks += p.LongestTasks;
-    total.Steps += p.Steps;
-    total.Tasks += p.Tasks;
-  }
+  rgmc::SpanPhase total;
+  const std::vector<rgmc::SpanPhase> phases = Profile(algorithm, repeats, total);
   std::ostringstream os;
   os << "{\"volume\": \"" << volume << "\", \"stage\": \"" << stage
      << "\", \"triangles\": " << triangles << ", \"work\": " << total.Work

@@ -5,15 +5,13 @@
 // and one group of everything; tasks in order, in reverse, and on threads.
 #include "rgmcCheck.h"
 #include "rgmcNodesBySlab.h"
+#include "rgmcTaskOrders.h"
 
 #include "vtkMarchingCubesTriangleCases.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstring>
-#include <functional>
 #include <random>
-#include <thread>
 #include <vector>
 
 namespace
@@ -25,44 +23,7 @@ const rgmc::CaseTable& Table()
   return table;
 }
 
-using Task = std::function<void(std::int64_t)>;
-
-void InOrder(std::int64_t count, const Task& task)
-{
-  for (std::int64_t i = 0; i < count; ++i)
-  {
-    task(i);
-  }
-}
-
-void Reversed(std::int64_t count, const Task& task)
-{
-  for (std::int64_t i = count - 1; i >= 0; --i)
-  {
-    task(i);
-  }
-}
-
-void Threads(std::int64_t count, const Task& task)
-{
-  std::atomic<std::int64_t> next{ 0 };
-  std::vector<std::thread> threads;
-  for (int t = 0; t < 4; ++t)
-  {
-    threads.emplace_back(
-      [&]()
-      {
-        for (std::int64_t i = next++; i < count; i = next++)
-        {
-          task(i);
-        }
-      });
-  }
-  for (std::thread& t : threads)
-  {
-    t.join();
-  }
-}
+using rgmc_test::Task;
 
 bool Same(const rgmc::SurfaceNode& a, const rgmc::SurfaceNode& b)
 {
@@ -147,9 +108,12 @@ int main()
   {
     for (std::size_t perGroup : { std::size_t(1), std::size_t(500), std::size_t(1) << 40 })
     {
-      Check(seed, 1 + static_cast<int>(seed * 7 % 60), perGroup, InOrder, "in order");
-      Check(seed, 1 + static_cast<int>(seed * 7 % 60), perGroup, Reversed, "reversed");
-      Check(seed, 1 + static_cast<int>(seed * 7 % 60), perGroup, Threads, "threads");
+      Check(
+        seed, 1 + static_cast<int>(seed * 7 % 60), perGroup, rgmc_test::TasksInOrder, "in order");
+      Check(
+        seed, 1 + static_cast<int>(seed * 7 % 60), perGroup, rgmc_test::TasksReversed, "reversed");
+      Check(
+        seed, 1 + static_cast<int>(seed * 7 % 60), perGroup, rgmc_test::TasksOnThreads, "threads");
     }
   }
   // Groups about equal in nodes: for 1000-node groups of 100 blocks of about 150 nodes, 5 to

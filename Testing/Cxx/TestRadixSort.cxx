@@ -5,12 +5,11 @@
 // in reverse order and on threads, the same.
 #include "rgmcCheck.h"
 #include "rgmcRadixSort.h"
+#include "rgmcTaskOrders.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <random>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -50,34 +49,7 @@ void Check(const std::vector<std::uint64_t>& keys, const char* what)
   // On tasks, run in reverse order and on 4 threads: the same records in the same order.
   for (int mode = 0; mode < 2; ++mode)
   {
-    auto parallel = [mode](std::int64_t count, auto&& task)
-    {
-      if (mode == 0)
-      {
-        for (std::int64_t i = count - 1; i >= 0; --i)
-        {
-          task(i);
-        }
-        return;
-      }
-      std::atomic<std::int64_t> next{ 0 };
-      std::vector<std::thread> threads;
-      for (int t = 0; t < 4; ++t)
-      {
-        threads.emplace_back(
-          [&]()
-          {
-            for (std::int64_t i = next++; i < count; i = next++)
-            {
-              task(i);
-            }
-          });
-      }
-      for (std::thread& t : threads)
-      {
-        t.join();
-      }
-    };
+    auto parallel = mode == 0 ? rgmc_test::TasksReversed : rgmc_test::TasksOnThreads;
     const char* how = mode == 0 ? "tasks reversed" : "tasks on threads";
     std::vector<Record> onTasks(keys.size());
     for (std::size_t i = 0; i < keys.size(); ++i)
