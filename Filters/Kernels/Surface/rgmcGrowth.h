@@ -399,8 +399,9 @@ private:
     this->TileCoordinates(tile, t);
     auto direction = [&](const Crossing& c)
     {
-      return static_cast<int>((((c.I - b.Lo[0]) >> 5) - t[0] + 1) +
-        3 * (((c.J - b.Lo[1]) >> 5) - t[1] + 1) + 9 * (((c.K - b.Lo[2]) >> 5) - t[2] + 1));
+      constexpr int s = GrowthTileBits;
+      return static_cast<int>((((c.I - b.Lo[0]) >> s) - t[0] + 1) +
+        3 * (((c.J - b.Lo[1]) >> s) - t[1] + 1) + 9 * (((c.K - b.Lo[2]) >> s) - t[2] + 1));
     };
     w.Posted += static_cast<std::int64_t>(w.Outbox.size());
     std::unique_ptr<Mail>& slot = w.Sent[round & 1];
