@@ -130,6 +130,61 @@ def parse_args(argv):
     return args
 
 
+class WriteFailed(Exception):
+    """A file could not be written; the earlier file at its path, if any, is left as it was."""
+
+
+def replace_file(path, write):
+    """Writes a file beside `path` with write(temporary path) (True when it succeeded), flushed to
+    the disk, then renames it over `path`: an earlier file there is replaced only by a complete
+    one, and on any failure it is left as it was and nothing is left beside it. The temporary
+    keeps the extension, for writers that choose their format by it."""
+    target = os.path.realpath(path)  # through a symbolic link, to the file it names
+    stem, extension = os.path.splitext(target)
+    temporary = "%s.rgmc-%d.part%s" % (stem, os.getpid(), extension)
+    try:
+        ok = write(temporary)
+        if ok and os.path.exists(temporary):
+            with open(temporary, "rb+") as written:
+                os.fsync(written.fileno())
+            os.replace(temporary, target)
+            return True
+        problem = "the writer failed (its error is above)"
+    except OSError as error:
+        problem = error.strerror or str(error)
+    try:
+        os.unlink(temporary)
+    except OSError:
+        pass
+    print("rgmc_pipeline: error: cannot write %s: %s; %s" % (
+        path, problem, "the earlier file is left as it was" if os.path.exists(target)
+        else "nothing was written"), file=sys.stderr)
+    return False
+
+
+def write_text(path, text):
+    with open(path, "w") as out:
+        out.write(text)
+    return True
+
+
+def write_surface(path, proxy):
+    """Writes the surface with the Merged Surface Writer (which replaces the file only when the
+    new one is complete, on every rank), and says whether it succeeded."""
+    from paraview import simple
+    writer = simple.CreateWriter(path, proxy=proxy, FileType="Binary")
+    writer.UpdatePipeline()
+    writer.UpdatePropertyInformation()
+    failed = writer.GetProperty("ErrorCode")
+    ok = failed is None or not failed.GetData()
+    simple.Delete(writer)
+    if not ok:
+        print("rgmc_pipeline: error: cannot write %s (the writer's error is above); %s" % (
+            path, "the earlier file is left as it was" if os.path.exists(path)
+            else "nothing was written"), file=sys.stderr)
+    return ok
+
+
 def measures(fields, medical):
     """Seam Repair's area and enclosed volume (JSON-ready: null for no volume), in the data's
     units: mm for DICOM, NIfTI and the phantom, with the volume in ml too."""
@@ -292,7 +347,9 @@ def render(source, args, ranks):
     display = show_surface(source, view, args.color_by)
     aim(view, source.GetDataInformation().GetBounds())
     os.makedirs(os.path.dirname(os.path.abspath(args.screenshot)), exist_ok=True)
-    simple.SaveScreenshot(args.screenshot, view, ImageResolution=[1200, 900])
+    if not replace_file(args.screenshot, lambda path: simple.SaveScreenshot(
+            path, view, ImageResolution=[1200, 900]) is not False):
+        raise WriteFailed(args.screenshot)
     simple.Delete(display)
     simple.Delete(view)
 
@@ -331,10 +388,25 @@ def render_beside_contour(volume, array, source, args):
     simple.AssignViewToLayout(view=left, layout=layout, hint=1)
     simple.AssignViewToLayout(view=right, layout=layout, hint=2)
     os.makedirs(os.path.dirname(os.path.abspath(args.screenshot)), exist_ok=True)
-    simple.SaveScreenshot(args.screenshot, layout, ImageResolution=[2000, 900])
+    if not replace_file(args.screenshot, lambda path: simple.SaveScreenshot(
+            path, layout, ImageResolution=[2000, 900]) is not False):
+        raise WriteFailed(args.screenshot)
     for display, view in shown:
         simple.Hide(display.Input, view)
     return contour.GetDataInformation().GetNumberOfCells()
+
+
+def picture(volume, array, final, args, ranks, report):
+    """The screenshot, if asked for (WriteFailed when it cannot be written)."""
+    if args.screenshot and args.beside_contour:
+        report["contour_triangles"] = render_beside_contour(volume, array, final, args)
+        report["outputs"].append(args.screenshot)
+        print("contour:    ParaView's Contour at %g gives %d triangles: every surface at that "
+              "value (left in the picture), %d of them the structure's" % (
+                  args.isovalue, report["contour_triangles"], report["triangles"]))
+    elif args.screenshot:
+        render(final, args, ranks)
+        report["outputs"].append(args.screenshot)
 
 
 def main(argv):
@@ -448,19 +520,16 @@ def main(argv):
     for extension in args.formats:
         # The plugin's Merged Surface Writer: one mesh, seam vertices merged, from any rank count.
         path = args.output + "." + extension
-        simple.SaveData(path, proxy=final, FileType="Binary")
+        if not write_surface(path, final):
+            return 1
         report["outputs"].append(path)
-    if args.screenshot and args.beside_contour:
-        report["contour_triangles"] = render_beside_contour(volume, array, final, args)
-        report["outputs"].append(args.screenshot)
-        print("contour:    ParaView's Contour at %g gives %d triangles: every surface at that "
-              "value (left in the picture), %d of them the structure's" % (
-                  args.isovalue, report["contour_triangles"], triangles))
-    elif args.screenshot:
-        render(final, args, ranks)
-        report["outputs"].append(args.screenshot)
-    with open(args.output + ".json", "w") as out:
-        json.dump(report, out, indent=2)
+    try:
+        picture(volume, array, final, args, ranks, report)
+    except WriteFailed:
+        return 1
+    if not replace_file(args.output + ".json",
+                        lambda path: write_text(path, json.dumps(report, indent=2) + "\n")):
+        return 1
     print("written:    %s" % ", ".join(report["outputs"] + [args.output + ".json"]))
     return 0
 

@@ -3,6 +3,7 @@
 #include "vtkRGMergedSurfaceWriter.h"
 
 #include "vtkRGCollective.h"
+#include "vtkRGMessage.h"
 #include "vtkRGRunController.h"
 #include "vtkRGSeamRepair.h"
 
@@ -30,11 +31,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <limits>
 #include <new>
 #include <string>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <utility>
 #include <vector>
@@ -53,16 +56,115 @@ class RangeFile
 public:
   ~RangeFile() { this->Close(); }
 
-  bool Open(const std::string& path, bool create)
+  /// Creates a new file beside `target` (in its directory, under a name of its own), which
+  /// Replace later renames over it: so an earlier file at `target` stays whole until the new one
+  /// is complete. A target that exists and is not a regular file (a device, a pipe) is written
+  /// in place; a symbolic link is followed. Errors name the target.
+  bool CreateBeside(const std::string& target)
   {
-    this->Path = path;
-    this->Descriptor =
-      ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (create ? O_CREAT | O_TRUNC : 0), 0666);
+    this->Shown = target;
+    this->Target = target;
+    struct stat st;
+    if (::lstat(target.c_str(), &st) == 0 && S_ISLNK(st.st_mode))
+    {
+      if (char* real = ::realpath(target.c_str(), nullptr))
+      {
+        this->Target = real;
+        std::free(real);
+      }
+      else // a link to a file yet to be made
+      {
+        std::vector<char> to(static_cast<std::size_t>(st.st_size) + 1, '\0');
+        const ssize_t n = ::readlink(target.c_str(), to.data(), to.size() - 1);
+        const std::size_t slash = target.find_last_of('/');
+        if (n > 0)
+        {
+          const std::string link(to.data(), static_cast<std::size_t>(n));
+          this->Target = link[0] == '/' || slash == std::string::npos
+            ? link
+            : target.substr(0, slash + 1) + link;
+        }
+      }
+    }
+    if (::stat(this->Target.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    {
+      this->Path = this->Target; // written in place: nothing to replace
+      this->Descriptor = ::open(this->Path.c_str(), O_WRONLY | O_CLOEXEC | O_TRUNC);
+    }
+    else
+    {
+      for (int attempt = 0; attempt < 100 && this->Descriptor < 0; ++attempt)
+      {
+        this->Path = this->Target + ".rgmc-" + std::to_string(::getpid()) + "-" +
+          std::to_string(attempt) + ".part";
+        this->Descriptor =
+          ::open(this->Path.c_str(), O_WRONLY | O_CLOEXEC | O_CREAT | O_EXCL, 0666);
+        if (this->Descriptor < 0 && errno != EEXIST)
+        {
+          break;
+        }
+      }
+    }
     if (this->Descriptor < 0)
     {
-      this->Fail(create ? "cannot create " : "cannot open ");
+      this->Fail("cannot create ");
     }
     return !this->Failed;
+  }
+
+  /// Opens the file that rank 0 created (CreateBeside's Path) for `target`.
+  bool Open(const std::string& path, const std::string& target)
+  {
+    this->Path = path;
+    this->Shown = target;
+    this->Descriptor = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (this->Descriptor < 0)
+    {
+      this->Fail("cannot open ");
+    }
+    return !this->Failed;
+  }
+
+  /// The file being written (the temporary one, or the target written in place).
+  const std::string& Written() const { return this->Path; }
+
+  /// Whether Replace has anything to do (the file was written beside its target).
+  bool Beside() const { return !this->Target.empty() && this->Path != this->Target; }
+
+  /// Renames the complete file over its target (CreateBeside's side only), then makes the
+  /// rename durable in the directory.
+  bool Replace()
+  {
+    if (!this->Beside())
+    {
+      return true;
+    }
+    if (::rename(this->Path.c_str(), this->Target.c_str()) != 0)
+    {
+      this->Fail("cannot replace ");
+      return false;
+    }
+    const std::size_t slash = this->Target.find_last_of('/');
+    const std::string directory = slash == std::string::npos
+      ? std::string(".")
+      : (slash == 0 ? std::string("/") : this->Target.substr(0, slash));
+    const int d = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (d >= 0)
+    {
+      ::fsync(d); // best effort: the rename is done either way
+      ::close(d);
+    }
+    return true;
+  }
+
+  /// Removes the file written beside the target (after a failure anywhere).
+  void Discard()
+  {
+    this->Close();
+    if (this->Beside())
+    {
+      ::unlink(this->Path.c_str());
+    }
   }
 
   void Write(Int offset, const char* data, std::size_t size)
@@ -115,11 +217,17 @@ public:
     return !this->Failed;
   }
 
+  /// Writes out what is buffered, makes it durable (so that the file renamed over the target
+  /// is complete even after a crash), and closes the file.
   bool Close()
   {
     if (this->Descriptor >= 0)
     {
       this->Flush();
+      if (!this->Failed && ::fsync(this->Descriptor) != 0 && errno != EINVAL && errno != EROFS)
+      {
+        this->Fail("cannot write ");
+      }
       if (::close(this->Descriptor) != 0 && !this->Failed)
       {
         this->Fail("cannot close ");
@@ -139,10 +247,12 @@ private:
   {
     const int error = errno;
     this->Failed = true;
-    this->Problem = std::string(what) + this->Path + ": " + std::strerror(error);
+    this->Problem = std::string(what) + this->Shown + ": " + std::strerror(error);
   }
 
-  std::string Path;
+  std::string Path;   // the file written
+  std::string Shown;  // the file the user named, for errors
+  std::string Target; // what Replace renames Path over (symbolic links followed)
   int Descriptor = -1;
   Int BufferStart = 0;
   std::vector<char> Buffer;
@@ -844,8 +954,10 @@ struct vtkRGMergedSurfaceWriter::Run
 //  PASS 2 NumberSurface   per attempt (at most 2): agreement (collected), AllGather (counts),
 //                         agreement, a reduction (ready); before the second, Seam Repair
 //                         without smoothing (its own schedule) and an agreement
-//  PASS 3 WriteMerged     a reduction (double points); agreement (rank 0 created the file),
-//  PASS 4                 agreement (every rank opened it), agreement (every rank wrote)
+//  PASS 3 WriteMerged     a reduction (double points); agreement (rank 0 created the file
+//                         beside the target), a broadcast (its name: two calls),
+//  PASS 4                 agreement (every rank opened it), agreement (every rank wrote it),
+//  PASS 5                 agreement (rank 0 renamed it over the target)
 void vtkRGMergedSurfaceWriter::WriteData()
 {
   rgmc::RunController controller(this->Controller);
@@ -995,8 +1107,10 @@ bool vtkRGMergedSurfaceWriter::NumberSurface(Run& run)
 }
 
 //------------------------------------------------------------------------------
-// Rank 0 creates the file, then every other rank opens it; every rank writes its records,
-// rank 0 also the texts. A file that failed on some rank is incomplete: it is removed.
+// Rank 0 creates a file beside the target, then every other rank opens it; every rank writes
+// its records, rank 0 also the texts, and makes them durable; then rank 0 renames the file over
+// the target. A file that failed on some rank is incomplete: it is removed and the target (an
+// earlier file) is left as it was.
 bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
 {
   rgmc::Ranks& ranks = run.Ranks;
@@ -1016,15 +1130,19 @@ bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
   }
   file.Plan();
 
-  // PASS 3: rank 0 creates the file, then every other rank opens it.
+  // PASS 3: rank 0 creates the file beside the target, then every other rank opens it.
   RangeFile out;
-  bool ok = ranks.Rank != 0 || out.Open(run.Name, true);
+  bool ok = ranks.Rank != 0 || out.CreateBeside(run.Name);
   if (!ranks.Agree(ok, out.Problem))
   {
     run.Problem = out.Problem;
     return false;
   }
-  ok = ranks.Rank == 0 || out.Open(run.Name, false);
+  std::vector<vtkIdType> words;
+  rgmc::MessageWriter(words).Text(out.Written());
+  ranks.Broadcast(words, 0);
+  const std::string written = rgmc::MessageReader(words).Text();
+  ok = ranks.Rank == 0 || out.Open(written, run.Name);
   run.Problem = out.Problem;
   if (ranks.Agree(ok, run.Problem))
   {
@@ -1044,15 +1162,24 @@ bool vtkRGMergedSurfaceWriter::WriteMerged(Run& run)
     {
       run.Problem = out.Problem;
     }
+    // PASS 5: every rank's records are durable: rank 0 renames the file over the target.
     if (ranks.Agree(ok, run.Problem))
     {
-      return true;
+      ok = ranks.Rank != 0 || out.Replace();
+      run.Problem = out.Problem;
+      if (ranks.Agree(ok, run.Problem))
+      {
+        return true;
+      }
     }
   }
-  out.Close();
   if (ranks.Rank == 0)
   {
-    ::unlink(run.Name.c_str());
+    out.Discard(); // the earlier file at the target, if any, is untouched
+  }
+  else
+  {
+    out.Close();
   }
   return false;
 }

@@ -21,9 +21,15 @@
  * 2. Sum the owned vertex and triangle counts, and prefix-sum the triangles (collective).
  *    Formats whose counts are 32-bit (STL's triangle count, PLY's vertex indices) give an
  *    error before anything is written when the mesh is larger.
- * 3. Rank 0 creates the file; the others open it once that is agreed.
- * 4. Each rank writes its vertices (grouped in runs of consecutive ids) and its triangles;
- *    the status of every rank is agreed, and a file that failed anywhere is removed.
+ * 3. Rank 0 creates a new file beside the target (same directory, the target's name followed
+ *    by .rgmc-<process>-<n>.part); the others open it once that is agreed.
+ * 4. Each rank writes its vertices (grouped in runs of consecutive ids) and its triangles and
+ *    flushes them to the disk (fsync); the status of every rank is agreed.
+ * 5. Rank 0 renames the file over the target. A file that failed anywhere is removed instead:
+ *    an earlier file at the target is never lost or truncated, and the error (the same on every
+ *    rank) names the target and the cause, for instance "No space left on device".
+ *    A symbolic link is followed; a target that is not a regular file (a device, a pipe) is
+ *    written in place. The .pvtp form is VTK's writer's and is written in place.
  *
  * The format follows the file name's extension: .stl (binary or ASCII), .ply (binary or ASCII,
  * with vertex normals when the surface has them), .vtp (VTK XML polydata with inline data,

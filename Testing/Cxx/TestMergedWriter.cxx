@@ -28,7 +28,10 @@
 #include <algorithm>
 #include <array>
 #include <csignal>
+#include <dirent.h>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <sys/resource.h>
@@ -235,10 +238,37 @@ std::string Message(const std::string& errors)
   return errors.substr(at + 3, end == std::string::npos ? std::string::npos : end - at - 3);
 }
 
-bool Exists(const std::string& path)
+/// A file's bytes (empty when it cannot be read).
+std::string Bytes(const std::string& path)
 {
-  struct stat s;
-  return ::stat(path.c_str(), &s) == 0;
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The names in a directory, sorted.
+std::vector<std::string> Listing(const std::string& dir)
+{
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(dir.c_str()))
+  {
+    while (const struct dirent* entry = ::readdir(d))
+    {
+      names.emplace_back(entry->d_name);
+    }
+    ::closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string Join(const std::vector<std::string>& names)
+{
+  std::string joined;
+  for (const std::string& name : names)
+  {
+    joined += (joined.empty() ? "" : " ") + name;
+  }
+  return joined;
 }
 
 } // namespace
@@ -349,8 +379,14 @@ int main(int argc, char* argv[])
       dir + "/skull.obj", "must end in .stl, .ply, .vtp or .pvtp", "an unknown extension");
 
     // The last rank's disk is full: a file size limit below its records (its writes fail with
-    // EFBIG instead of the signal, which the test ignores).
+    // EFBIG instead of the signal, which the test ignores). An earlier file at the target stays
+    // byte for byte, and nothing is left beside it.
     const std::string full = dir + "/full.ply";
+    const Written earlier = Write(controller, repaired, full, VTK_ASCII);
+    RGMC_CHECK(earlier.Ok, "the earlier file: " << earlier.Errors);
+    controller->Barrier();
+    const std::string earlierBytes = rank == 0 ? Bytes(full) : std::string();
+    const std::vector<std::string> earlierListing = Listing(dir);
     struct rlimit saved;
     ::getrlimit(RLIMIT_FSIZE, &saved);
     void (*previous)(int) = std::signal(SIGXFSZ, SIG_IGN);
@@ -372,8 +408,34 @@ int main(int argc, char* argv[])
       "a full disk (rank " << rank << "): the error does not name it: " << e.Errors);
     RGMC_CHECK(
       SameOnAllRanks(controller, Message(e.Errors)), "a full disk: the ranks' messages differ");
+    RGMC_CHECK(e.Errors.find(full) != std::string::npos,
+      "a full disk (rank " << rank << "): the error does not name " << full << ": " << e.Errors);
     controller->Barrier();
-    RGMC_CHECK(!Exists(full), "a full disk: the incomplete file is still there");
+    if (rank == 0)
+    {
+      RGMC_CHECK(Bytes(full) == earlierBytes,
+        "a full disk: the earlier " << full << " was changed (" << Bytes(full).size()
+                                    << " bytes, not " << earlierBytes.size() << ")");
+      RGMC_CHECK(Listing(dir) == earlierListing,
+        "a full disk: files were left beside the target: " << Join(Listing(dir)));
+    }
+
+    // Through a symbolic link: the file it points to is replaced, the link stays a link.
+    if (rank == 0)
+    {
+      ::unlink((dir + "/link.stl").c_str());
+      RGMC_CHECK(::symlink("pointed.stl", (dir + "/link.stl").c_str()) == 0, "symlink");
+    }
+    controller->Barrier();
+    const Written linked = Write(controller, repaired, dir + "/link.stl", VTK_BINARY);
+    RGMC_CHECK(linked.Ok && linked.Errors.empty(), "through a link: " << linked.Errors);
+    if (rank == 0)
+    {
+      struct stat st;
+      RGMC_CHECK(::lstat((dir + "/link.stl").c_str(), &st) == 0 && S_ISLNK(st.st_mode),
+        "through a link: the link was replaced by a file");
+      Compare(Read(dir + "/pointed.stl"), reference, false, false, "through a link");
+    }
   }
 
   return rgmc_test::Finish(controller, "TestMergedWriter");

@@ -59,12 +59,13 @@ def finish(name):
     return 0
 
 
-def run(command, timeout=900, env=None, tail=None):
+def run(command, timeout=900, env=None, tail=None, preexec_fn=None):
     """Runs `command`, prints it and its output (the last `tail` characters of each stream when
-    given), and returns the finished process."""
+    given), and returns the finished process. `preexec_fn` runs in the child before the command
+    (limits, signals)."""
     print("+ " + " ".join(command), flush=True)
     result = subprocess.run(command, capture_output=True, text=True, errors="replace",
-                            timeout=timeout, env=env)
+                            timeout=timeout, env=env, preexec_fn=preexec_fn)
     print(result.stdout[-tail:] if tail else result.stdout)
     print(result.stderr[-tail:] if tail else result.stderr, file=sys.stderr)
     return result
