@@ -1,6 +1,7 @@
 // vtkRGDecimate: quadric-error decimation in independent blocks, distributed over the ranks by a
 // grid that depends on the surface alone (see the header for the scheme).
 #include "vtkRGDecimate.h"
+#include "rgmcDecimateDistance.h"
 #include "rgmcDecimateMessages.h"
 #include "rgmcDecimateParts.h"
 #include "rgmcDecimation.h"
@@ -341,6 +342,8 @@ struct vtkRGDecimate::Run
 //                             AllReduce (error), agreement
 //  PASS 8 NumberSurface       step BuildDecimatedPiece; vtkRGSeamRepair's own schedule (no
 //                             smoothing)
+//  PASS 9 (ComputeDistance)   rgmc::DecimationDistance's schedule (rgmcDecimateDistance.h): its
+//                             collectives depend on counts every rank has agreed
 int vtkRGDecimate::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -400,7 +403,7 @@ int vtkRGDecimate::RequestData(
       break;
     }
   }
-  // PASS 8: one mesh again, with normals, checks and measures.
+  // PASS 8-9: one mesh again, with normals, checks and measures; the distance to the input.
   if (!this->NumberSurface(run, output))
   {
     return fail();
@@ -1125,7 +1128,9 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
   };
   add("TrianglesBeforeDecimation", static_cast<double>(run.InputTriangles));
   add("DecimationQuadricError", std::sqrt(run.MaximumLevel));
-  return true;
+  // PASS 9: the distance from the input surface, where the triangles are.
+  return !this->ComputeDistance ||
+    rgmc::ReportDecimationDistance(run.Ranks, run.Input, output, run.Problem);
 }
 
 //------------------------------------------------------------------------------
@@ -1174,6 +1179,7 @@ void vtkRGDecimate::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "TargetReduction: " << this->TargetReduction << "\n";
   os << indent << "MaximumError: " << this->MaximumError << "\n";
+  os << indent << "ComputeDistance: " << this->ComputeDistance << "\n";
   os << indent << "TrianglesPerBlock: " << this->TrianglesPerBlock << "\n";
   os << indent << "TrianglesPerWave: " << this->TrianglesPerWave << "\n";
   os << indent << "Controller: " << this->Controller << "\n";

@@ -106,6 +106,20 @@ public:
 
   ///@{
   /**
+   * Whether to report the distance from the input surface (default on): field arrays
+   * DecimationHausdorffDistance and DecimationMeanDistance, in world units, the same on every
+   * rank. Measured from every vertex of each surface (each global vertex once) to the nearest
+   * point of the other surface, exactly, where the triangles are (nothing is gathered):
+   * Hausdorff is the largest of those distances, the mean is the mean of the two directions'
+   * means (the sum exact, so the same for any number of ranks and threads).
+   */
+  vtkSetMacro(ComputeDistance, vtkTypeBool);
+  vtkGetMacro(ComputeDistance, vtkTypeBool);
+  vtkBooleanMacro(ComputeDistance, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * About how many triangles a block holds (default 20000; at least 100): the grid's cubes are
    * sized for this many on a surface spanning its bounds. Smaller blocks spread over more ranks
    * and threads, larger ones leave fewer vertices fixed at their faces. The result depends on
@@ -148,6 +162,7 @@ protected:
 
   double TargetReduction = 0.9;
   double MaximumError = 0.0;
+  vtkTypeBool ComputeDistance = 1;
   vtkIdType TrianglesPerBlock = 20000;
   vtkIdType TrianglesPerWave = 4000000;
   vtkMultiProcessController* Controller = nullptr;

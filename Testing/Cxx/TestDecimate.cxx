@@ -126,9 +126,10 @@ const vtkIdType TrianglesPerBlock = 500;
 
 Decimated Decimate(vtkMultiProcessController* controller, vtkPolyData* input, double reduction,
   double maximumError = 0.0, vtkIdType trianglesPerBlock = TrianglesPerBlock,
-  vtkIdType trianglesPerWave = 4000000)
+  vtkIdType trianglesPerWave = 4000000, bool computeDistance = true)
 {
   vtkNew<vtkRGDecimate> decimate;
+  decimate->SetComputeDistance(computeDistance);
   vtkNew<MessageCatcher> catcher;
   catcher->Watch(decimate);
   decimate->SetController(controller);
@@ -274,6 +275,34 @@ double FarthestVertex(vtkPolyData* decimated, vtkPolyData* original)
     worst = std::max(worst, std::sqrt(d2));
   }
   return worst;
+}
+
+/// The mean distance from the vertices of `from` to the surface `to` (a cell locator's exact
+/// closest points: the oracle of Decimate Surface's distance report).
+double MeanNearest(vtkPolyData* from, vtkPolyData* to)
+{
+  vtkNew<vtkCellLocator> locator;
+  locator->SetDataSet(to);
+  locator->BuildLocator();
+  vtkNew<vtkGenericCell> cell;
+  double sum = 0;
+  for (vtkIdType p = 0; p < from->GetNumberOfPoints(); ++p)
+  {
+    double x[3], closest[3], d2;
+    vtkIdType cellId;
+    int subId;
+    from->GetPoint(p, x);
+    locator->FindClosestPoint(x, closest, cell, cellId, subId, d2);
+    sum += std::sqrt(d2);
+  }
+  return sum / std::max<vtkIdType>(1, from->GetNumberOfPoints());
+}
+
+/// A field value of the output (NaN when missing).
+double Field(vtkPolyData* pd, const char* name)
+{
+  vtkDataArray* a = vtkDataArray::SafeDownCast(pd->GetFieldData()->GetAbstractArray(name));
+  return a && a->GetNumberOfTuples() == 1 ? a->GetTuple1(0) : std::nan("");
 }
 
 /// How many triangles of `decimated` face away from the triangle of `original` nearest to their
@@ -453,6 +482,7 @@ int main(int argc, char* argv[])
   {
     // The 1-rank reference.
     Merged reference;
+    double hausdorffOne = 0, meanOne = 0;
     if (rank == 0)
     {
       vtkSmartPointer<vtkImageData> whole = surface.Make(Whole);
@@ -476,6 +506,25 @@ int main(int argc, char* argv[])
         const long long away = FacingAway(AsPolyData(reference), AsPolyData(input).GetPointer());
         RGMC_CHECK(away == 0,
           surface.Name << ": " << away << " triangles face away from the original surface");
+      }
+      // The distance report against the locator's: every vertex of each surface (once) to the
+      // other surface, the largest and the mean of the two directions' means.
+      {
+        vtkSmartPointer<vtkPolyData> in = AsPolyData(input), out = AsPolyData(reference);
+        const double hausdorff = std::max(FarthestVertex(out, in), FarthestVertex(in, out));
+        const double mean = 0.5 * (MeanNearest(in, out) + MeanNearest(out, in));
+        hausdorffOne = Field(d.Output, "DecimationHausdorffDistance");
+        meanOne = Field(d.Output, "DecimationMeanDistance");
+        std::cout << surface.Name << ": distance report Hausdorff " << hausdorffOne << " mean "
+                  << meanOne << "; the locator's " << hausdorff << ", " << mean << "\n";
+        RGMC_CHECK(std::abs(hausdorffOne - hausdorff) <= 1e-9 * (1 + hausdorff) &&
+            std::abs(meanOne - mean) <= 1e-9 * (1 + mean),
+          surface.Name << ": the distance report (" << hausdorffOne << ", " << meanOne
+                       << ") is not the locator's (" << hausdorff << ", " << mean << ")");
+        const Decimated off =
+          Decimate(single, repaired, reduction, 0.0, TrianglesPerBlock, 1 << 30, false);
+        RGMC_CHECK(std::isnan(Field(off.Output, "DecimationHausdorffDistance")),
+          surface.Name << ": Compute Distance off, yet a distance is reported");
       }
       // In waves (the blocks made and simplified a few at a time, then made again to apply
       // what they keep): the same surface to the bit.
@@ -557,7 +606,16 @@ int main(int argc, char* argv[])
         RGMC_CHECK(output.Triangles == reference.Triangles,
           what << ": the triangles differ from 1 rank's (" << output.Triangles.size() << " and "
                << reference.Triangles.size() << ", or in another order)");
+        const double h = Field(d.Output, "DecimationHausdorffDistance");
+        const double m = Field(d.Output, "DecimationMeanDistance");
+        RGMC_CHECK(
+          std::memcmp(&h, &hausdorffOne, sizeof h) == 0 && std::memcmp(&m, &meanOne, sizeof m) == 0,
+          what << ": the distance report (" << h << ", " << m << ") is not 1 rank's ("
+               << hausdorffOne << ", " << meanOne << ") to the bit");
       }
+      RGMC_CHECK(
+        SameOnAllRanks(controller, std::to_string(Field(d.Output, "DecimationMeanDistance"))),
+        what << ": the ranks' distance reports differ");
       // In waves, on the first decomposition: each rank's blocks a few at a time.
       if (how == Decompositions(ranks).front())
       {

@@ -1,0 +1,295 @@
+// The distance from points to a triangle surface, exactly: the smallest distance from the point
+// to any triangle (closest point on the triangle, Ericson's regions), found through a grid of
+// buckets over the triangles and bounded by a search radius. The distance of a point to one
+// triangle is computed from the triangle's corners in a canonical rotation (smallest corner
+// first, orientation kept), so it is the same double whatever order the triangles come in and
+// whichever other triangles are near: the smallest over any superset of the triangles within
+// the radius is the same value, to the bit.
+#ifndef rgmcSurfaceDistance_h
+#define rgmcSurfaceDistance_h
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace rgmc
+{
+
+/// The squared distance from p to the triangle (a, b, c) (its closest point, by the region of
+/// the triangle's plane p projects into; Ericson, Real-Time Collision Detection, 5.1.5).
+inline double PointTriangleDistance2(
+  const double p[3], const double a[3], const double b[3], const double c[3])
+{
+  auto sub = [](const double* u, const double* v, double* w)
+  {
+    w[0] = u[0] - v[0];
+    w[1] = u[1] - v[1];
+    w[2] = u[2] - v[2];
+  };
+  auto dot = [](const double* u, const double* v)
+  { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  auto to = [&](const double* q)
+  {
+    double d[3];
+    sub(p, q, d);
+    return dot(d, d);
+  };
+  auto along = [&](const double* from, const double* e, double t)
+  {
+    const double q[3] = { from[0] + t * e[0], from[1] + t * e[1], from[2] + t * e[2] };
+    return to(q);
+  };
+  double ab[3], ac[3], ap[3], bp[3], cp[3];
+  sub(b, a, ab);
+  sub(c, a, ac);
+  sub(p, a, ap);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0)
+  {
+    return to(a);
+  }
+  sub(p, b, bp);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3)
+  {
+    return to(b);
+  }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0)
+  {
+    return along(a, ab, d1 / (d1 - d3));
+  }
+  sub(p, c, cp);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6)
+  {
+    return to(c);
+  }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0)
+  {
+    return along(a, ac, d2 / (d2 - d6));
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+  {
+    double bc[3];
+    sub(c, b, bc);
+    return along(b, bc, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  }
+  const double sum = va + vb + vc;
+  if (!(sum > 0)) // a degenerate triangle: its three edges
+  {
+    double bc[3];
+    sub(c, b, bc);
+    auto segment = [&](const double* from, const double* e)
+    {
+      const double l = dot(e, e);
+      double d[3];
+      sub(p, from, d);
+      const double t = l > 0 ? std::min(1.0, std::max(0.0, dot(d, e) / l)) : 0.0;
+      return along(from, e, t);
+    };
+    return std::min({ segment(a, ab), segment(a, ac), segment(b, bc) });
+  }
+  const double v = vb / sum, w = vc / sum;
+  const double q[3] = { a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w,
+    a[2] + ab[2] * v + ac[2] * w };
+  return to(q);
+}
+
+/// Rotates a triangle's 9 coordinates so that its smallest corner (x, then y, then z) comes
+/// first, keeping its orientation: the canonical form PointTriangleDistance2 is applied to.
+inline void CanonicalTriangle(double t[9])
+{
+  auto less = [t](int i, int j)
+  { return std::lexicographical_compare(t + 3 * i, t + 3 * i + 3, t + 3 * j, t + 3 * j + 3); };
+  const int first = less(1, 0) ? (less(2, 1) ? 2 : 1) : (less(2, 0) ? 2 : 0);
+  if (first != 0)
+  {
+    double r[9];
+    for (int k = 0; k < 9; ++k)
+    {
+      r[k] = t[(3 * first + k) % 9];
+    }
+    std::copy(r, r + 9, t);
+  }
+}
+
+/// Triangles (9 coordinates each, canonical) in a grid of cubic buckets: each triangle is in
+/// every bucket its bounding box overlaps.
+class TriangleBuckets
+{
+public:
+  /// `corners`: 9 coordinates a triangle, kept by reference; `size`: the buckets' edge.
+  TriangleBuckets(const std::vector<double>& corners, double size)
+    : Corners(corners)
+  {
+    const std::size_t n = corners.size() / 9;
+    this->Build(n, size);
+  }
+
+  /// The smallest squared distance from p to a triangle, searching the buckets within `limit`
+  /// of p (a triangle farther than `limit` may be missed: a result above limit^2 means "none
+  /// within limit"). Infinity when there is no triangle within reach.
+  double Nearest2(const double p[3], double limit) const
+  {
+    double best = std::numeric_limits<double>::infinity();
+    if (this->Count.empty())
+    {
+      return best;
+    }
+    const double reach2 = limit * limit;
+    int home[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      home[a] = this->Cell(p[a], a);
+    }
+    const int shells = static_cast<int>(std::min<double>(std::ceil(limit / this->Size) + 1,
+      std::max({ this->Dims[0], this->Dims[1], this->Dims[2] })));
+    for (int s = 0; s <= shells; ++s)
+    {
+      const double gap = (s - 1) * this->Size; // no bucket of shell s is nearer than this
+      if (s > 1 && gap * gap > std::min(best, reach2))
+      {
+        break;
+      }
+      this->VisitShell(p, home, s, std::min(best, reach2), best);
+    }
+    return best;
+  }
+
+private:
+  int Cell(double x, int a) const
+  {
+    const double c = std::floor((x - this->Origin[a]) / this->Size);
+    return static_cast<int>(std::max(0.0, std::min<double>(c, this->Dims[a] - 1)));
+  }
+
+  void Build(std::size_t n, double size)
+  {
+    if (n == 0)
+    {
+      return;
+    }
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::numeric_limits<double>::infinity();
+      hi[a] = -lo[a];
+    }
+    for (std::size_t t = 0; t < n; ++t)
+    {
+      for (int k = 0; k < 9; ++k)
+      {
+        lo[k % 3] = std::min(lo[k % 3], this->Corners[9 * t + k]);
+        hi[k % 3] = std::max(hi[k % 3], this->Corners[9 * t + k]);
+      }
+    }
+    // At most about 4 buckets a triangle, and 256 along an axis: larger buckets for few
+    // triangles in a large box (a surface fills few of its box's buckets; each costs 8 bytes).
+    double extent = 0, volume = 1;
+    for (int a = 0; a < 3; ++a)
+    {
+      extent = std::max(extent, hi[a] - lo[a]);
+      volume *= std::max(hi[a] - lo[a], size);
+    }
+    this->Size = std::max({ size, extent / 256.0, std::cbrt(volume / (4.0 * n)) });
+    if (!(this->Size > 0))
+    {
+      this->Size = 1;
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Origin[a] = lo[a];
+      this->Dims[a] = std::max(1, static_cast<int>(std::floor((hi[a] - lo[a]) / this->Size)) + 1);
+    }
+    const std::size_t buckets = std::size_t(this->Dims[0]) * this->Dims[1] * this->Dims[2];
+    this->Count.assign(buckets + 1, 0);
+    this->ForBuckets(n, [this](std::size_t b, std::size_t) { ++this->Count[b + 1]; });
+    for (std::size_t b = 0; b < buckets; ++b)
+    {
+      this->Count[b + 1] += this->Count[b];
+    }
+    this->Items.resize(this->Count[buckets]);
+    std::vector<std::uint64_t> next(this->Count.begin(), this->Count.end() - 1);
+    this->ForBuckets(n,
+      [this, &next](std::size_t b, std::size_t t)
+      { this->Items[next[b]++] = static_cast<std::uint32_t>(t); });
+  }
+
+  template <typename F>
+  void ForBuckets(std::size_t n, F&& f) const
+  {
+    for (std::size_t t = 0; t < n; ++t)
+    {
+      const double* c = this->Corners.data() + 9 * t;
+      int lo[3], hi[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = this->Cell(std::min({ c[a], c[3 + a], c[6 + a] }), a);
+        hi[a] = this->Cell(std::max({ c[a], c[3 + a], c[6 + a] }), a);
+      }
+      for (int z = lo[2]; z <= hi[2]; ++z)
+      {
+        for (int y = lo[1]; y <= hi[1]; ++y)
+        {
+          for (int x = lo[0]; x <= hi[0]; ++x)
+          {
+            f(x + std::size_t(this->Dims[0]) * (y + std::size_t(this->Dims[1]) * z), t);
+          }
+        }
+      }
+    }
+  }
+
+  /// The buckets at Chebyshev distance s from `home` whose box is within `bound` (squared) of p.
+  void VisitShell(const double p[3], const int home[3], int s, double bound, double& best) const
+  {
+    for (int z = home[2] - s; z <= home[2] + s; ++z)
+    {
+      for (int y = home[1] - s; y <= home[1] + s; ++y)
+      {
+        const bool edge =
+          z == home[2] - s || z == home[2] + s || y == home[1] - s || y == home[1] + s;
+        for (int x = home[0] - s; x <= home[0] + s; x += (edge || s == 0) ? 1 : 2 * s)
+        {
+          const int c[3] = { x, y, z };
+          double box2 = 0;
+          bool inside = true;
+          for (int a = 0; a < 3 && inside; ++a)
+          {
+            inside = c[a] >= 0 && c[a] < this->Dims[a];
+            const double lo = this->Origin[a] + c[a] * this->Size;
+            const double d = p[a] < lo ? lo - p[a] : std::max(0.0, p[a] - (lo + this->Size));
+            box2 += d * d;
+          }
+          if (!inside || box2 > std::min(bound, best))
+          {
+            continue;
+          }
+          const std::size_t b =
+            x + std::size_t(this->Dims[0]) * (y + std::size_t(this->Dims[1]) * z);
+          for (std::uint64_t i = this->Count[b]; i < this->Count[b + 1]; ++i)
+          {
+            const double* t = this->Corners.data() + 9 * std::size_t(this->Items[i]);
+            best = std::min(best, PointTriangleDistance2(p, t, t + 3, t + 6));
+          }
+        }
+      }
+    }
+  }
+
+  const std::vector<double>& Corners;
+  double Origin[3] = { 0, 0, 0 };
+  double Size = 1;
+  int Dims[3] = { 1, 1, 1 };
+  std::vector<std::uint64_t> Count; // bucket b's items: [Count[b], Count[b + 1])
+  std::vector<std::uint32_t> Items;
+};
+
+} // namespace rgmc
+
+#endif

@@ -1,0 +1,415 @@
+// Decimate Surface's distance report, measured where the triangles are: the symmetric Hausdorff
+// distance and the mean distance between the input surface and the decimated one, from every
+// vertex of each (each global vertex once: the copies Seam Repair flags as duplicates are
+// skipped) to the other surface (the nearest point of its nearest triangle, exactly).
+//
+// Nothing is gathered. Space is cut into cells; each vertex goes to its cell's rank, with the
+// other surface's triangles that come within a radius R of the cell (its halo). A vertex whose
+// nearest triangle is within R has its exact distance; the few farther ones are measured again
+// in a next round, R eight times larger, with the triangles sent again for their cells only,
+// until none is left (R beyond the surfaces' extent sends every triangle). A vertex's distance
+// to one triangle does not depend on the ranks (rgmcSurfaceDistance.h), the smallest over any
+// superset of the triangles within R is the same value, the maximum is exact, and the mean's
+// sum is an ExactSum: the figures are the same to the bit on any number of ranks and threads.
+#ifndef rgmcDecimateDistance_h
+#define rgmcDecimateDistance_h
+
+#include "rgmcMeasure.h"
+#include "rgmcSurfaceDistance.h"
+#include "vtkRGCollective.h"
+#include "vtkRGParallel.h"
+#include "vtkRGSpan.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellArrayIterator.h"
+#include "vtkCommunicator.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace rgmc
+{
+constexpr int DistancePointsTag = 7411, DistanceTrianglesTag = 7413, DistanceCellsTag = 7415;
+
+/// One surface's part on this rank: its owned vertices and its triangles (canonical corners).
+struct DistanceSurface
+{
+  std::vector<double> Points;    // 3 a vertex, each global vertex on one rank only
+  std::vector<double> Triangles; // 9 a triangle
+  double Lo[3] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+    std::numeric_limits<double>::max() };
+  double Hi[3] = { -std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
+    -std::numeric_limits<double>::max() };
+
+  explicit DistanceSurface(vtkPolyData* pd)
+  {
+    vtkPoints* points = pd->GetPoints();
+    vtkCellArray* polys = pd->GetPolys();
+    if (!points || !polys)
+    {
+      return;
+    }
+    auto* ghosts = vtkUnsignedCharArray::SafeDownCast(
+      pd->GetPointData()->GetArray(vtkDataSetAttributes::GhostArrayName()));
+    double x[3];
+    for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i)
+    {
+      if (ghosts && (ghosts->GetValue(i) & vtkDataSetAttributes::DUPLICATEPOINT))
+      {
+        continue;
+      }
+      points->GetPoint(i, x);
+      this->Points.insert(this->Points.end(), x, x + 3);
+    }
+    this->Triangles.reserve(9 * static_cast<std::size_t>(polys->GetNumberOfCells()));
+    auto it = vtk::TakeSmartPointer(polys->NewIterator());
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+    {
+      vtkIdType n;
+      const vtkIdType* ids;
+      it->GetCurrentCell(n, ids);
+      if (n != 3)
+      {
+        continue;
+      }
+      double t[9];
+      for (int k = 0; k < 3; ++k)
+      {
+        points->GetPoint(ids[k], t + 3 * k);
+      }
+      CanonicalTriangle(t);
+      this->Triangles.insert(this->Triangles.end(), t, t + 9);
+      for (int k = 0; k < 9; ++k)
+      {
+        this->Lo[k % 3] = std::min(this->Lo[k % 3], t[k]);
+        this->Hi[k % 3] = std::max(this->Hi[k % 3], t[k]);
+      }
+    }
+  }
+};
+
+/// The distances from one surface's vertices to the other's triangles, over all ranks.
+struct DirectedDistance
+{
+  double Max = 0;
+  ExactSum Sum;
+  std::int64_t Count = 0;
+};
+
+/// The cells that own the vertices: a grid over the surfaces' global box, each cell's rank by a
+/// hash of its position (so a region's work spreads over the ranks).
+struct DistanceCells
+{
+  double Origin[3] = { 0, 0, 0 };
+  double Size = 1;
+  std::int64_t Dims[3] = { 1, 1, 1 };
+  int Ranks = 1;
+
+  std::int64_t CellOf(const double* p) const
+  {
+    std::int64_t c[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      c[a] = std::max<std::int64_t>(0,
+        std::min<std::int64_t>(this->Dims[a] - 1,
+          static_cast<std::int64_t>(std::floor((p[a] - this->Origin[a]) / this->Size))));
+    }
+    return c[0] + this->Dims[0] * (c[1] + this->Dims[1] * c[2]);
+  }
+  int RankOf(std::int64_t cell) const
+  {
+    const std::uint64_t h = static_cast<std::uint64_t>(cell) * 0x9E3779B97F4A7C15ull;
+    return static_cast<int>((h >> 32) % static_cast<std::uint64_t>(this->Ranks));
+  }
+  /// Calls f(cell) for every cell that a box grown by r overlaps.
+  template <typename F>
+  void ForCellsNear(const double* lo, const double* hi, double r, F&& f) const
+  {
+    std::int64_t a0[3], a1[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      auto at = [&](double x)
+      {
+        return std::max<std::int64_t>(0,
+          std::min<std::int64_t>(this->Dims[a] - 1,
+            static_cast<std::int64_t>(std::floor((x - this->Origin[a]) / this->Size))));
+      };
+      a0[a] = at(lo[a] - r);
+      a1[a] = at(hi[a] + r);
+    }
+    for (std::int64_t z = a0[2]; z <= a1[2]; ++z)
+    {
+      for (std::int64_t y = a0[1]; y <= a1[1]; ++y)
+      {
+        for (std::int64_t x = a0[0]; x <= a1[0]; ++x)
+        {
+          f(x + this->Dims[0] * (y + this->Dims[1] * z));
+        }
+      }
+    }
+  }
+};
+
+/// Measures the vertices `points` (at their cell's rank already) against `triangles`, within
+/// `limit`: adds the resolved ones to `into`, returns the others' coordinates.
+inline std::vector<double> MeasureWithin(const std::vector<double>& points,
+  const std::vector<double>& triangles, double bucket, double limit, DirectedDistance& into)
+{
+  const TriangleBuckets buckets(triangles, bucket);
+  const std::size_t n = points.size() / 3;
+  const vtkIdType grain = 4096;
+  const vtkIdType tasks = static_cast<vtkIdType>((n + grain - 1) / grain);
+  std::vector<DirectedDistance> parts(static_cast<std::size_t>(tasks));
+  std::vector<std::vector<double>> far(static_cast<std::size_t>(tasks));
+  ParallelFor(tasks, 1,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType task = begin; task < end; ++task)
+      {
+        DirectedDistance& part = parts[task];
+        const std::size_t last =
+          std::min<std::size_t>(n, static_cast<std::size_t>(task + 1) * grain);
+        for (std::size_t i = static_cast<std::size_t>(task) * grain; i < last; ++i)
+        {
+          const double* p = points.data() + 3 * i;
+          const double d2 = buckets.Nearest2(p, limit);
+          if (d2 > limit * limit)
+          {
+            far[task].insert(far[task].end(), p, p + 3);
+            continue;
+          }
+          const double d = std::sqrt(d2);
+          part.Max = std::max(part.Max, d);
+          part.Sum.Add(d);
+          ++part.Count;
+        }
+      }
+    });
+  std::vector<double> unresolved;
+  for (vtkIdType task = 0; task < tasks; ++task)
+  {
+    into.Max = std::max(into.Max, parts[task].Max);
+    into.Sum.Add(parts[task].Sum);
+    into.Count += parts[task].Count;
+    unresolved.insert(unresolved.end(), far[task].begin(), far[task].end());
+  }
+  return unresolved;
+}
+
+inline bool ReduceDirected(Ranks& ranks, DirectedDistance& result, std::string& problem);
+
+/// The distances from `from`'s vertices to `to`'s triangles, over all ranks (collective).
+inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const DistanceSurface& to,
+  const DistanceCells& cells, double radius, double extent, DirectedDistance& result,
+  std::string& problem)
+{
+  const int size = ranks.Size;
+  if (size == 1) // every triangle is here: one search, without copies
+  {
+    TryLocally(problem, "measure the distances",
+      [&]()
+      {
+        MeasureWithin(
+          from.Points, to.Triangles, radius / 2, std::numeric_limits<double>::infinity(), result);
+      });
+    return ranks.Agree(problem.empty(), problem) && ReduceDirected(ranks, result, problem);
+  }
+  std::vector<bool> everyone(static_cast<std::size_t>(size), true);
+  // Round 0: every vertex to its cell's rank; later rounds: the far ones stay where they are.
+  std::vector<std::vector<double>> outgoing(static_cast<std::size_t>(size));
+  for (std::size_t i = 0; i < from.Points.size(); i += 3)
+  {
+    const double* p = from.Points.data() + i;
+    auto& to_ = outgoing[cells.RankOf(cells.CellOf(p))];
+    to_.insert(to_.end(), p, p + 3);
+  }
+  std::vector<double> mine;
+  for (const auto& part : ranks.Exchange(outgoing, everyone, DistancePointsTag))
+  {
+    mine.insert(mine.end(), part.begin(), part.end());
+  }
+  for (double r = radius;; r *= 8)
+  {
+    const bool all = r >= extent; // every triangle goes to every rank that still has vertices
+    // The cells with vertices still to measure, known to every rank.
+    std::vector<vtkIdType> wanted;
+    for (std::size_t i = 0; i < mine.size(); i += 3)
+    {
+      wanted.push_back(cells.CellOf(mine.data() + i));
+    }
+    std::sort(wanted.begin(), wanted.end());
+    wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+    std::vector<std::vector<vtkIdType>> told(static_cast<std::size_t>(size), wanted);
+    const auto cellsOf = ranks.Exchange(told, everyone, DistanceCellsTag);
+    std::vector<std::vector<vtkIdType>> sorted(cellsOf.begin(), cellsOf.end());
+    std::vector<std::vector<double>> triangles(static_cast<std::size_t>(size));
+    for (std::size_t t = 0; t < to.Triangles.size(); t += 9)
+    {
+      const double* c = to.Triangles.data() + t;
+      const double lo[3] = { std::min({ c[0], c[3], c[6] }), std::min({ c[1], c[4], c[7] }),
+        std::min({ c[2], c[5], c[8] }) };
+      const double hi[3] = { std::max({ c[0], c[3], c[6] }), std::max({ c[1], c[4], c[7] }),
+        std::max({ c[2], c[5], c[8] }) };
+      std::vector<int> sentTo;
+      cells.ForCellsNear(lo, hi, all ? extent : r,
+        [&](std::int64_t cell)
+        {
+          const int owner = cells.RankOf(cell);
+          if (std::binary_search(sorted[owner].begin(), sorted[owner].end(), cell) &&
+            std::find(sentTo.begin(), sentTo.end(), owner) == sentTo.end())
+          {
+            sentTo.push_back(owner);
+            triangles[owner].insert(triangles[owner].end(), c, c + 9);
+          }
+        });
+    }
+    std::vector<double> near;
+    for (const auto& part : ranks.Exchange(triangles, everyone, DistanceTrianglesTag))
+    {
+      near.insert(near.end(), part.begin(), part.end());
+    }
+    TryLocally(problem, "measure the distances",
+      [&]()
+      {
+        mine = MeasureWithin(
+          mine, near, radius / 2, all ? std::numeric_limits<double>::infinity() : r, result);
+      });
+    std::int64_t left = static_cast<std::int64_t>(mine.size() / 3), anyLeft = 0;
+    ranks.AllReduce(&left, &anyLeft, 1, vtkCommunicator::SUM_OP, "counting the far vertices");
+    if (!ranks.Agree(problem.empty(), problem))
+    {
+      return false;
+    }
+    if (anyLeft == 0 || all)
+    {
+      break;
+    }
+  }
+  return ReduceDirected(ranks, result, problem);
+}
+
+/// The largest distance, the exact sum and the count over the ranks (collective).
+inline bool ReduceDirected(Ranks& ranks, DirectedDistance& result, std::string& problem)
+{
+  double largest = 0;
+  ranks.AllReduce(&result.Max, &largest, 1, vtkCommunicator::MAX_OP, "the largest distance");
+  std::int64_t words[ExactSum::Words + 1], sums[ExactSum::Words + 1];
+  result.Sum.ToWords(words);
+  words[ExactSum::Words] = result.Count;
+  ranks.AllReduce(words, sums, ExactSum::Words + 1, vtkCommunicator::SUM_OP, "the mean distance");
+  result.Max = largest;
+  result.Sum = ExactSum::FromWordSums(sums);
+  result.Count = sums[ExactSum::Words];
+  return ranks.Agree(true, problem);
+}
+
+/// The symmetric Hausdorff distance and the mean distance (the mean of the two directions'
+/// means) between `input` and `output`, the same on every rank (collective).
+inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* output,
+  double& hausdorff, double& mean, std::string& problem)
+{
+  SpanMark("distance");
+  DistanceSurface* a = nullptr;
+  DistanceSurface* b = nullptr;
+  std::unique_ptr<DistanceSurface> ownA, ownB;
+  TryLocally(problem, "collect the surfaces for the distance",
+    [&]()
+    {
+      ownA.reset(new DistanceSurface(input));
+      ownB.reset(new DistanceSurface(output));
+    });
+  if (!ranks.Agree(problem.empty(), problem))
+  {
+    return false;
+  }
+  a = ownA.get();
+  b = ownB.get();
+  // The global box, and the triangle counts (the search radius follows the triangles' size).
+  double box[6], global[6];
+  for (int k = 0; k < 3; ++k)
+  {
+    box[k] = std::min(a->Lo[k], b->Lo[k]);
+    box[3 + k] = -std::max(a->Hi[k], b->Hi[k]);
+  }
+  ranks.AllReduce(box, global, 6, vtkCommunicator::MIN_OP, "the surfaces' box");
+  std::int64_t counts[2] = { static_cast<std::int64_t>(a->Triangles.size() / 9),
+    static_cast<std::int64_t>(b->Triangles.size() / 9) },
+               totals[2];
+  ranks.AllReduce(counts, totals, 2, vtkCommunicator::SUM_OP, "the triangle counts");
+  if (!ranks.Agree(true, problem))
+  {
+    return false;
+  }
+  double extent = 0;
+  for (int k = 0; k < 3; ++k)
+  {
+    extent = std::max(extent, -global[3 + k] - global[k]);
+  }
+  if (totals[0] == 0 || totals[1] == 0 || !(extent > 0) || !std::isfinite(extent))
+  {
+    hausdorff = mean = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  DistanceCells cells;
+  cells.Ranks = ranks.Size;
+  const double diagonal = extent * std::sqrt(3.0);
+  auto radiusFor = [&](std::int64_t triangles)
+  { return 2 * diagonal / std::sqrt(static_cast<double>(triangles)); };
+  const double radius = std::max(radiusFor(totals[0]), radiusFor(totals[1]));
+  cells.Size = std::max(8 * radius, extent / 64);
+  for (int k = 0; k < 3; ++k)
+  {
+    cells.Origin[k] = global[k];
+    cells.Dims[k] = static_cast<std::int64_t>((-global[3 + k] - global[k]) / cells.Size) + 1;
+  }
+  DirectedDistance there, back;
+  if (!MeasureDirected(ranks, *a, *b, cells, radiusFor(totals[1]), 2 * diagonal, there, problem) ||
+    !MeasureDirected(ranks, *b, *a, cells, radiusFor(totals[0]), 2 * diagonal, back, problem))
+  {
+    return false;
+  }
+  hausdorff = std::max(there.Max, back.Max);
+  mean = there.Count > 0 && back.Count > 0
+    ? 0.5 * (there.Sum.Get() / there.Count + back.Sum.Get() / back.Count)
+    : std::numeric_limits<double>::quiet_NaN();
+  return true;
+}
+
+/// DecimationDistance, added to `output`'s field data as DecimationHausdorffDistance and
+/// DecimationMeanDistance (collective).
+inline bool ReportDecimationDistance(
+  Ranks& ranks, vtkPolyData* input, vtkPolyData* output, std::string& problem)
+{
+  double hausdorff = 0, mean = 0;
+  if (!DecimationDistance(ranks, input, output, hausdorff, mean, problem))
+  {
+    return false;
+  }
+  for (const auto& value : { std::make_pair("DecimationHausdorffDistance", hausdorff),
+         std::make_pair("DecimationMeanDistance", mean) })
+  {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(value.first);
+    a->InsertNextValue(value.second);
+    output->GetFieldData()->AddArray(a);
+  }
+  return true;
+}
+
+} // namespace rgmc
+
+#endif
