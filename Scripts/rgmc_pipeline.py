@@ -379,7 +379,40 @@ def picture(volume, array, final, args, ranks, report):
         report["outputs"].append(args.screenshot)
 
 
+class Stages:
+    """The job's wall time in consecutive stages (each from the end of the one before), so that
+    they add up to the whole; the first, start-up, is the process's age when the script began
+    (pvbatch's own start and MPI's)."""
+
+    def __init__(self):
+        self.last = time.time()
+        self.seconds = {"start-up": process_age()}
+
+    def mark(self, name):
+        now = time.time()
+        self.seconds[name] = self.seconds.get(name, 0.0) + now - self.last
+        self.last = now
+
+    def report(self):
+        return {name: round(value, 4) for name, value in self.seconds.items()}
+
+    def total(self):
+        return sum(self.seconds.values())
+
+
+def process_age():
+    """Seconds since this process started (Linux /proc), or 0 where that is not known."""
+    try:
+        with open("/proc/self/stat") as stat:
+            started = int(stat.read().rsplit(")", 1)[1].split()[19])
+        with open("/proc/uptime") as uptime:
+            return max(0.0, float(uptime.read().split()[0]) - started / os.sysconf("SC_CLK_TCK"))
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
 def main(argv):
+    stages = Stages()
     args = parse_args(argv)
     if args.connect:
         rgmc_common.connect(args.connect)
@@ -397,6 +430,7 @@ def main(argv):
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_WARNING)
     rgmc_common.load_plugin(args.plugin, args.server_plugin)
 
+    stages.mark("start-up")
     started = time.time()
     volume = rgmc_common.open_volume(args.input)
     volume.UpdatePipeline()
@@ -433,6 +467,7 @@ def main(argv):
     extract_seconds = time.time() - started
     simple.Delete(timed)
     triangles = surface.GetDataInformation().GetNumberOfCells()
+    stages.mark("read and extract")
 
     report = {
         "input": args.input, "dimensions": dims, "array": array, "array_range": list(value_range),
@@ -465,6 +500,7 @@ def main(argv):
     started = time.time()
     repaired.UpdatePipeline()
     report["repair_seconds"] = round(time.time() - started, 4)
+    stages.mark("repair")
     report["smoothing"] = {"method": args.smooth, "iterations": args.iterations}
     data_information = repaired.GetDataInformation()  # keep it alive while reading it
     fields = data_information.DataInformation.GetFieldDataInformation()
@@ -481,9 +517,11 @@ def main(argv):
     report["measures"] = measures(fields, medical=bool(summary) or args.input.startswith("phantom:"))
     print("measures:   %s" % describe_measures(report["measures"]))
 
+    stages.mark("measures")
     final = repaired
     if args.decimate is not None or args.max_error is not None:
         final = decimate(repaired, args, report)
+        stages.mark("decimate and distance")
 
     directory = os.path.dirname(os.path.abspath(args.output))
     os.makedirs(directory, exist_ok=True)
@@ -493,10 +531,17 @@ def main(argv):
         if not write_surface(path, final):
             return 1
         report["outputs"].append(path)
+    stages.mark("write")
     try:
         picture(volume, array, final, args, ranks, report)
     except WriteFailed:
         return 1
+    if args.screenshot:
+        stages.mark("picture")
+    report["stages_seconds"] = stages.report()
+    report["wall_seconds"] = round(stages.total(), 4)
+    print("stages:     %s; %.2f s in all" % (", ".join(
+        "%s %.2f s" % item for item in stages.seconds.items()), stages.total()))
     if not replace_file(args.output + ".json",
                         lambda path: write_text(path, json.dumps(report, indent=2) + "\n")):
         return 1

@@ -169,7 +169,9 @@ struct DistanceCells
 inline std::vector<double> MeasureWithin(const std::vector<double>& points,
   const std::vector<double>& triangles, double bucket, double limit, DirectedDistance& into)
 {
+  SpanMark("distance: buckets");
   const TriangleBuckets buckets(triangles, bucket);
+  SpanMark("distance: nearest triangles");
   const std::size_t n = points.size() / 3;
   const vtkIdType grain = 4096;
   const vtkIdType tasks = static_cast<vtkIdType>((n + grain - 1) / grain);
@@ -214,7 +216,7 @@ inline bool ReduceDirected(Ranks& ranks, DirectedDistance& result, std::string& 
 
 /// The distances from `from`'s vertices to `to`'s triangles, over all ranks (collective).
 inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const DistanceSurface& to,
-  const DistanceCells& cells, double radius, double extent, DirectedDistance& result,
+  const DistanceCells& cells, double radius, double bucket, double extent, DirectedDistance& result,
   std::string& problem)
 {
   const int size = ranks.Size;
@@ -224,7 +226,7 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
       [&]()
       {
         MeasureWithin(
-          from.Points, to.Triangles, radius / 2, std::numeric_limits<double>::infinity(), result);
+          from.Points, to.Triangles, bucket, std::numeric_limits<double>::infinity(), result);
       });
     return ranks.Agree(problem.empty(), problem) && ReduceDirected(ranks, result, problem);
   }
@@ -286,7 +288,7 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
       [&]()
       {
         mine = MeasureWithin(
-          mine, near, radius / 2, all ? std::numeric_limits<double>::infinity() : r, result);
+          mine, near, bucket, all ? std::numeric_limits<double>::infinity() : r, result);
       });
     std::int64_t left = static_cast<std::int64_t>(mine.size() / 3), anyLeft = 0;
     ranks.AllReduce(&left, &anyLeft, 1, vtkCommunicator::SUM_OP, "counting the far vertices");
@@ -322,7 +324,7 @@ inline bool ReduceDirected(Ranks& ranks, DirectedDistance& result, std::string& 
 inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* output,
   double& hausdorff, double& mean, std::string& problem)
 {
-  SpanMark("distance");
+  SpanMark("distance: collect");
   DistanceSurface* a = nullptr;
   DistanceSurface* b = nullptr;
   std::unique_ptr<DistanceSurface> ownA, ownB;
@@ -377,8 +379,14 @@ inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* ou
     cells.Dims[k] = static_cast<std::int64_t>((-global[3 + k] - global[k]) / cells.Size) + 1;
   }
   DirectedDistance there, back;
-  if (!MeasureDirected(ranks, *a, *b, cells, radiusFor(totals[1]), 2 * diagonal, there, problem) ||
-    !MeasureDirected(ranks, *b, *a, cells, radiusFor(totals[0]), 2 * diagonal, back, problem))
+  // Buckets of about one query vertex each (a closed surface has half as many vertices as
+  // triangles): few triangles to test a query, few buckets a triangle.
+  auto bucketFor = [&](std::int64_t triangles)
+  { return 2 * diagonal / std::sqrt(std::max(1.0, 0.5 * static_cast<double>(triangles))); };
+  if (!MeasureDirected(ranks, *a, *b, cells, radiusFor(totals[1]), bucketFor(totals[0]),
+        2 * diagonal, there, problem) ||
+    !MeasureDirected(ranks, *b, *a, cells, radiusFor(totals[0]), bucketFor(totals[1]), 2 * diagonal,
+      back, problem))
   {
     return false;
   }

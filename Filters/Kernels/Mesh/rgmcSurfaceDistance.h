@@ -8,6 +8,8 @@
 #ifndef rgmcSurfaceDistance_h
 #define rgmcSurfaceDistance_h
 
+#include "rgmcKeyMap.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -126,6 +128,7 @@ public:
   /// `corners`: 9 coordinates a triangle, kept by reference; `size`: the buckets' edge.
   TriangleBuckets(const std::vector<double>& corners, double size)
     : Corners(corners)
+    , Index(corners.size() / 9)
   {
     const std::size_t n = corners.size() / 9;
     this->Build(n, size);
@@ -137,7 +140,7 @@ public:
   double Nearest2(const double p[3], double limit) const
   {
     double best = std::numeric_limits<double>::infinity();
-    if (this->Count.empty())
+    if (this->Start.empty())
     {
       return best;
     }
@@ -188,15 +191,14 @@ private:
         hi[k % 3] = std::max(hi[k % 3], this->Corners[9 * t + k]);
       }
     }
-    // At most about 4 buckets a triangle, and 256 along an axis: larger buckets for few
-    // triangles in a large box (a surface fills few of its box's buckets; each costs 8 bytes).
-    double extent = 0, volume = 1;
+    // Buckets are kept only where there are triangles (a hash of their position), so their size
+    // follows the queries, not the box; at most 2^20 along an axis.
+    double extent = 0;
     for (int a = 0; a < 3; ++a)
     {
       extent = std::max(extent, hi[a] - lo[a]);
-      volume *= std::max(hi[a] - lo[a], size);
     }
-    this->Size = std::max({ size, extent / 256.0, std::cbrt(volume / (4.0 * n)) });
+    this->Size = std::max(size, extent / (1 << 20));
     if (!(this->Size > 0))
     {
       this->Size = 1;
@@ -206,18 +208,35 @@ private:
       this->Origin[a] = lo[a];
       this->Dims[a] = std::max(1, static_cast<int>(std::floor((hi[a] - lo[a]) / this->Size)) + 1);
     }
-    const std::size_t buckets = std::size_t(this->Dims[0]) * this->Dims[1] * this->Dims[2];
-    this->Count.assign(buckets + 1, 0);
-    this->ForBuckets(n, [this](std::size_t b, std::size_t) { ++this->Count[b + 1]; });
-    for (std::size_t b = 0; b < buckets; ++b)
-    {
-      this->Count[b + 1] += this->Count[b];
-    }
-    this->Items.resize(this->Count[buckets]);
-    std::vector<std::uint64_t> next(this->Count.begin(), this->Count.end() - 1);
+    // Each (bucket, triangle) pair, the bucket numbered in the order first met; then the
+    // triangles grouped by bucket (a counting sort).
+    std::vector<std::uint32_t> pairs;
+    std::vector<std::uint64_t> counts;
     this->ForBuckets(n,
-      [this, &next](std::size_t b, std::size_t t)
-      { this->Items[next[b]++] = static_cast<std::uint32_t>(t); });
+      [&](std::int64_t key, std::size_t t)
+      {
+        bool inserted;
+        const std::int32_t v =
+          this->Index.FindOrInsert(key, static_cast<std::int32_t>(counts.size()), inserted);
+        if (inserted)
+        {
+          counts.push_back(0);
+        }
+        ++counts[static_cast<std::size_t>(v)];
+        pairs.push_back(static_cast<std::uint32_t>(v));
+        pairs.push_back(static_cast<std::uint32_t>(t));
+      });
+    this->Start.assign(counts.size() + 1, 0);
+    for (std::size_t b = 0; b < counts.size(); ++b)
+    {
+      this->Start[b + 1] = this->Start[b] + counts[b];
+    }
+    this->Items.resize(this->Start.back());
+    std::vector<std::uint64_t> next(this->Start.begin(), this->Start.end() - 1);
+    for (std::size_t i = 0; i < pairs.size(); i += 2)
+    {
+      this->Items[next[pairs[i]]++] = pairs[i + 1];
+    }
   }
 
   template <typename F>
@@ -238,11 +257,16 @@ private:
         {
           for (int x = lo[0]; x <= hi[0]; ++x)
           {
-            f(x + std::size_t(this->Dims[0]) * (y + std::size_t(this->Dims[1]) * z), t);
+            f(this->Key(x, y, z), t);
           }
         }
       }
     }
+  }
+
+  std::int64_t Key(int x, int y, int z) const
+  {
+    return x + std::int64_t(this->Dims[0]) * (y + std::int64_t(this->Dims[1]) * z);
   }
 
   /// The buckets at Chebyshev distance s from `home` whose box is within `bound` (squared) of p.
@@ -270,9 +294,13 @@ private:
           {
             continue;
           }
-          const std::size_t b =
-            x + std::size_t(this->Dims[0]) * (y + std::size_t(this->Dims[1]) * z);
-          for (std::uint64_t i = this->Count[b]; i < this->Count[b + 1]; ++i)
+          const std::int32_t* found = this->Index.Find(this->Key(x, y, z));
+          if (!found)
+          {
+            continue;
+          }
+          const std::size_t b = static_cast<std::size_t>(*found);
+          for (std::uint64_t i = this->Start[b]; i < this->Start[b + 1]; ++i)
           {
             const double* t = this->Corners.data() + 9 * std::size_t(this->Items[i]);
             best = std::min(best, PointTriangleDistance2(p, t, t + 3, t + 6));
@@ -286,7 +314,8 @@ private:
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
   int Dims[3] = { 1, 1, 1 };
-  std::vector<std::uint64_t> Count; // bucket b's items: [Count[b], Count[b + 1])
+  KeyMap Index;                     // a bucket's key (Key) to its number b
+  std::vector<std::uint64_t> Start; // bucket b's items: [Start[b], Start[b + 1])
   std::vector<std::uint32_t> Items;
 };
 
