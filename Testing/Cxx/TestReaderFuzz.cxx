@@ -63,8 +63,10 @@ std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::siz
         break;
       case 1: // an interesting byte
       {
-        static const char values[] = { 0, -1, 0x7f, -128, 1, 0x20 };
-        bytes[position()] = values[std::uniform_int_distribution<int>(0, 5)(random)];
+        // Bytes, the same on any platform (char is unsigned on arm64).
+        static const unsigned char values[] = { 0x00, 0xff, 0x7f, 0x80, 0x01, 0x20 };
+        bytes[position()] =
+          static_cast<char>(values[std::uniform_int_distribution<int>(0, 5)(random)]);
         break;
       }
       case 2: // an interesting 32-bit value (lengths, dimensions)
