@@ -11,15 +11,15 @@
 // surface (sampled at the vertices of each surface, to the other surface, in voxels), and whether
 // the output is closed (every edge in exactly two triangles, once each way). Each rank builds
 // only its block of the volume. Prints one JSON object per line on rank 0.
-#include "rgmcBenchmark.h"       // Now, IntList
-#include "rgmcDistributedData.h" // BlockPiece, PhantomPiece, MarkGhostCells
+#include "rgmcBenchmark.h"        // Now, IntList
+#include "rgmcDistributedData.h"  // BlockPiece, PhantomPiece, MarkGhostCells
+#include "rgmcNearestDistances.h" // Nearest
 #include "vtkRGDecimate.h"
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGSeamRepair.h"
 
 #include "vtkCellArray.h"
 #include "vtkDecimatePro.h"
-#include "vtkGenericCell.h"
 #include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
 #include "vtkMPIController.h"
@@ -29,7 +29,6 @@
 #include "vtkPolyData.h"
 #include "vtkQuadricDecimation.h"
 #include "vtkSMPTools.h"
-#include "vtkStaticCellLocator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -96,23 +95,9 @@ vtkSmartPointer<vtkPolyData> Merge(vtkMultiProcessController* controller, vtkPol
 /// The largest and mean distance from the vertices of `from` to the surface `to`.
 void Distances(vtkPolyData* from, vtkPolyData* to, double& largest, double& mean)
 {
-  vtkNew<vtkStaticCellLocator> locator;
-  locator->SetDataSet(to);
-  locator->BuildLocator();
-  vtkNew<vtkGenericCell> cell;
-  largest = 0;
-  double sum = 0;
-  for (vtkIdType p = 0; p < from->GetNumberOfPoints(); ++p)
-  {
-    double x[3], closest[3], d2;
-    vtkIdType cellId;
-    int subId;
-    from->GetPoint(p, x);
-    locator->FindClosestPoint(x, closest, cell, cellId, subId, d2);
-    largest = std::max(largest, std::sqrt(d2));
-    sum += std::sqrt(d2);
-  }
-  mean = from->GetNumberOfPoints() ? sum / from->GetNumberOfPoints() : 0;
+  const rgmc_test::NearestDistances d = rgmc_test::Nearest(from, to);
+  largest = d.Largest;
+  mean = d.Mean;
 }
 
 /// Whether every edge is in exactly two triangles, once in each direction.

@@ -9,6 +9,7 @@
 // when an error bound is set; made in waves (TrianglesPerWave), the same surface to the bit.
 // Bad input gives the same error on every rank.
 #include "rgmcDistributedData.h"
+#include "rgmcNearestDistances.h"
 #include "rgmcTestController.h"
 #include "rgmcTestData.h"
 #include "rgmcUnitedMesh.h"
@@ -260,42 +261,7 @@ std::vector<std::array<std::array<std::uint64_t, 3>, 3>> TrianglesByPosition(con
 /// The largest distance from a vertex of `decimated` to the surface `original`.
 double FarthestVertex(vtkPolyData* decimated, vtkPolyData* original)
 {
-  vtkNew<vtkCellLocator> locator;
-  locator->SetDataSet(original);
-  locator->BuildLocator();
-  vtkNew<vtkGenericCell> cell;
-  double worst = 0;
-  for (vtkIdType p = 0; p < decimated->GetNumberOfPoints(); ++p)
-  {
-    double x[3], closest[3], d2;
-    vtkIdType cellId;
-    int subId;
-    decimated->GetPoint(p, x);
-    locator->FindClosestPoint(x, closest, cell, cellId, subId, d2);
-    worst = std::max(worst, std::sqrt(d2));
-  }
-  return worst;
-}
-
-/// The mean distance from the vertices of `from` to the surface `to` (a cell locator's exact
-/// closest points: the oracle of Decimate Surface's distance report).
-double MeanNearest(vtkPolyData* from, vtkPolyData* to)
-{
-  vtkNew<vtkCellLocator> locator;
-  locator->SetDataSet(to);
-  locator->BuildLocator();
-  vtkNew<vtkGenericCell> cell;
-  double sum = 0;
-  for (vtkIdType p = 0; p < from->GetNumberOfPoints(); ++p)
-  {
-    double x[3], closest[3], d2;
-    vtkIdType cellId;
-    int subId;
-    from->GetPoint(p, x);
-    locator->FindClosestPoint(x, closest, cell, cellId, subId, d2);
-    sum += std::sqrt(d2);
-  }
-  return sum / std::max<vtkIdType>(1, from->GetNumberOfPoints());
+  return rgmc_test::Nearest(decimated, original).Largest;
 }
 
 /// A field value of the output (NaN when missing).
@@ -512,7 +478,8 @@ int main(int argc, char* argv[])
       {
         vtkSmartPointer<vtkPolyData> in = AsPolyData(input), out = AsPolyData(reference);
         const double hausdorff = std::max(FarthestVertex(out, in), FarthestVertex(in, out));
-        const double mean = 0.5 * (MeanNearest(in, out) + MeanNearest(out, in));
+        const double mean =
+          0.5 * (rgmc_test::Nearest(in, out).Mean + rgmc_test::Nearest(out, in).Mean);
         hausdorffOne = Field(d.Output, "DecimationHausdorffDistance");
         meanOne = Field(d.Output, "DecimationMeanDistance");
         std::cout << surface.Name << ": distance report Hausdorff " << hausdorffOne << " mean "

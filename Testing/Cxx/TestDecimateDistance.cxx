@@ -5,11 +5,10 @@
 // an interleaved share of the triangles and of the vertices) and on 1 and 16 threads.
 #include "rgmcCheck.h"
 #include "rgmcDecimateDistance.h"
+#include "rgmcNearestDistances.h"
 #include "rgmcTestController.h"
 
-#include "vtkCellLocator.h"
 #include "vtkDummyController.h"
-#include "vtkGenericCell.h"
 #include "vtkIdList.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
@@ -68,28 +67,6 @@ vtkSmartPointer<vtkPolyData> Share(vtkPolyData* whole, int rank, int ranks)
   return pd;
 }
 
-/// The largest and the mean distance from the points of `from` to the surface `to`.
-void Oracle(vtkPolyData* from, vtkPolyData* to, double& largest, double& mean)
-{
-  vtkNew<vtkCellLocator> locator;
-  locator->SetDataSet(to);
-  locator->BuildLocator();
-  vtkNew<vtkGenericCell> cell;
-  largest = 0;
-  double sum = 0;
-  for (vtkIdType p = 0; p < from->GetNumberOfPoints(); ++p)
-  {
-    double x[3], closest[3], d2;
-    vtkIdType cellId;
-    int subId;
-    from->GetPoint(p, x);
-    locator->FindClosestPoint(x, closest, cell, cellId, subId, d2);
-    largest = std::max(largest, std::sqrt(d2));
-    sum += std::sqrt(d2);
-  }
-  mean = sum / from->GetNumberOfPoints();
-}
-
 bool Measure(vtkMultiProcessController* controller, vtkPolyData* a, vtkPolyData* b, int threads,
   double& hausdorff, double& mean)
 {
@@ -134,10 +111,8 @@ int main(int argc, char* argv[])
     vtkSmartPointer<vtkPolyData> b = Sphere(c.RadiusB, c.CentreB, c.ResolutionB);
     double oneHausdorff = 0, oneMean = 0;
     Measure(single, Share(a, 0, 1), Share(b, 0, 1), 1, oneHausdorff, oneMean);
-    double ab, abMean, ba, baMean;
-    Oracle(a, b, ab, abMean);
-    Oracle(b, a, ba, baMean);
-    const double hausdorff = std::max(ab, ba), mean = 0.5 * (abMean + baMean);
+    const rgmc_test::NearestDistances ab = rgmc_test::Nearest(a, b), ba = rgmc_test::Nearest(b, a);
+    const double hausdorff = std::max(ab.Largest, ba.Largest), mean = 0.5 * (ab.Mean + ba.Mean);
     if (rank == 0)
     {
       std::cout << c.Name << ": Hausdorff " << oneHausdorff << " mean " << oneMean
