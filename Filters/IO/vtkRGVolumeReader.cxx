@@ -2,6 +2,7 @@
 // broadcast; each rank reads its own slab; every status agreed over all ranks.
 #include "vtkRGVolumeReader.h"
 
+#include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 #include "vtkRGMessage.h"
 #include "vtkRGRunController.h"
@@ -252,6 +253,7 @@ int vtkRGVolumeReader::RequestData(
   }
   if (!empty)
   {
+    rgmc::CacheRanges(scalars);
     output->GetPointData()->SetScalars(scalars);
     // Mark the ghost layers the pipeline asked for, as ParaView's image sources do, so that
     // filters know which cells this rank owns.

@@ -1,14 +1,16 @@
 // Helpers for VTK arrays shared by the filters (private to the module): storage that fails with
 // std::bad_alloc, as the rest of the filters' allocations do (VTK's own path reports a failed
 // allocation through its error output, which needs memory too: with the memory exhausted it
-// aborted the process, measured in TestOutOfMemory), and the count of a cell array's cells that
-// are not triangles.
+// aborted the process, measured in TestOutOfMemory), the count of a cell array's cells that
+// are not triangles, and an array's value ranges computed once where it is made.
 #ifndef vtkRGArrays_h
 #define vtkRGArrays_h
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkAbstractArray.h"
 #include "vtkCellArray.h"
+
+class vtkDataArray;
 
 #include <algorithm>
 #include <cstdlib>
@@ -65,6 +67,16 @@ inline vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
   }
   return other;
 }
+
+/// Stores `array`'s range and finite range, per component, where VTK keeps them once computed
+/// (vtkAbstractArray::PER_COMPONENT and PER_FINITE_COMPONENT), so that GetRange,
+/// GetFiniteRange and ParaView's data information find them instead of scanning the array again
+/// (30 ns a value in Debian's VTK 9.2 against about 1 here: 1.7 s for each of the two scans of a
+/// 384^3 volume). The same values VTK computes: for every component the smallest and largest
+/// value, NaN skipped, and the finite ones; for an array that is not one contiguous block, of no
+/// values, or with a component without one, nothing is stored and VTK computes as before. Call
+/// it once the values are final: VTK drops the ranges when the array is modified.
+void CacheRanges(vtkDataArray* array);
 
 } // namespace rgmc
 

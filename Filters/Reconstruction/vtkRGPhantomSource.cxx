@@ -2,11 +2,15 @@
 // ramps and deterministic per-voxel noise.
 #include "vtkRGPhantomSource.h"
 
+#include "vtkRGArrays.h"
+#include "vtkRGParallel.h"
+
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkSMPTools.h"
 #include "vtkShortArray.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
@@ -248,32 +252,54 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
   image->GetOrigin(origin);
   image->GetSpacing(spacing);
   const std::uint64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
+  const vtkIdType slice = vtkIdType(ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1);
   short* out = hu->GetPointer(0);
-  for (int k = ext[4]; k <= ext[5]; ++k)
+  // Every voxel is a function of its index alone, so the slices are made on the threads with
+  // the same result; progress and abort are checked between waves of slices, on this thread.
+  const int wave = 4 * std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads());
+  for (int first = ext[4]; first <= ext[5]; first += wave)
   {
     if (ext[5] > ext[4])
     {
-      this->UpdateProgress(double(k - ext[4]) / (ext[5] - ext[4]));
+      this->UpdateProgress(double(first - ext[4]) / (ext[5] - ext[4] + 1));
     }
     if (this->CheckAbort())
     {
       break;
     }
-    for (int j = ext[2]; j <= ext[3]; ++j)
-    {
-      for (int i = ext[0]; i <= ext[1]; ++i)
+    const int last = std::min(ext[5], first + wave - 1);
+    rgmc::ParallelFor(last - first + 1, 1,
+      [&](vtkIdType begin, vtkIdType end)
       {
-        const double p[3] = { origin[0] + i * spacing[0], origin[1] + j * spacing[1],
-          origin[2] + k * spacing[2] };
-        double v = this->Evaluate(p);
-        if (this->NoiseLevel > 0)
+        for (vtkIdType s = begin; s < end; ++s)
         {
-          v += this->NoiseLevel * Noise((std::uint64_t(k) * ny + j) * nx + i, this->RandomSeed);
+          const int k = first + static_cast<int>(s);
+          short* v = out + (k - ext[4]) * slice;
+          for (int j = ext[2]; j <= ext[3]; ++j)
+          {
+            for (int i = ext[0]; i <= ext[1]; ++i)
+            {
+              *v++ = this->Sample(origin, spacing, i, j, k, nx, ny);
+            }
+          }
         }
-        *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3071.0, v))));
-      }
-    }
+      });
   }
+  rgmc::CacheRanges(hu);
+}
+
+//------------------------------------------------------------------------------
+short vtkRGPhantomSource::Sample(const double origin[3], const double spacing[3], int i, int j,
+  int k, std::uint64_t nx, std::uint64_t ny) const
+{
+  const double p[3] = { origin[0] + i * spacing[0], origin[1] + j * spacing[1],
+    origin[2] + k * spacing[2] };
+  double v = this->Evaluate(p);
+  if (this->NoiseLevel > 0)
+  {
+    v += this->NoiseLevel * Noise((std::uint64_t(k) * ny + j) * nx + i, this->RandomSeed);
+  }
+  return static_cast<short>(std::lround(std::max(-1024.0, std::min(3071.0, v))));
 }
 
 //------------------------------------------------------------------------------

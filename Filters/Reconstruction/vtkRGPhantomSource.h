@@ -26,6 +26,8 @@
 #include "RGMCReconstructionModule.h" // For export macro
 #include "vtkImageAlgorithm.h"
 
+#include <cstdint> // For std::uint64_t
+
 class RGMCRECONSTRUCTION_EXPORT vtkRGPhantomSource : public vtkImageAlgorithm
 {
 public:
@@ -88,6 +90,9 @@ private:
 
   double Spacing() const;
   double Ramp() const;
+  /// The voxel (i, j, k) in HU, noise included, clamped and rounded to int16.
+  short Sample(const double origin[3], const double spacing[3], int i, int j, int k,
+    std::uint64_t nx, std::uint64_t ny) const;
 };
 
 #endif

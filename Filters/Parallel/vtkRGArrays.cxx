@@ -1,0 +1,159 @@
+// An array's ranges computed once, in parallel, where the array is made (vtkRGArrays.h).
+#include "vtkRGArrays.h"
+
+#include "vtkRGParallel.h"
+
+#include "vtkDataArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationDoubleVectorKey.h"
+#include "vtkInformationInformationVectorKey.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+
+#include <cmath>
+#include <limits>
+#include <type_traits>
+#include <vector>
+
+namespace
+{
+
+/// The smallest and largest value of one component, NaN skipped (All), and of its finite values
+/// (Finite), in the array's own type until the end.
+template <typename T>
+struct Extremes
+{
+  // Floating types start from the infinities, so that an infinite value is its own extreme.
+  static constexpr T Highest = std::numeric_limits<T>::has_infinity
+    ? std::numeric_limits<T>::infinity()
+    : std::numeric_limits<T>::max();
+  static constexpr T Lowest = std::numeric_limits<T>::has_infinity
+    ? -std::numeric_limits<T>::infinity()
+    : std::numeric_limits<T>::lowest();
+  T AllLow = Highest, AllHigh = Lowest, FiniteLow = Highest, FiniteHigh = Lowest;
+  bool AnyValue = false, AnyFinite = false;
+
+  void Add(T v)
+  {
+    if constexpr (std::is_floating_point<T>::value)
+    {
+      if (std::isnan(v))
+      {
+        return;
+      }
+      if (std::isfinite(v))
+      {
+        this->AddFinite(v);
+      }
+    }
+    else
+    {
+      this->AddFinite(v);
+    }
+    this->AllLow = std::min(this->AllLow, v);
+    this->AllHigh = std::max(this->AllHigh, v);
+    this->AnyValue = true;
+  }
+
+  void AddFinite(T v)
+  {
+    this->FiniteLow = std::min(this->FiniteLow, v);
+    this->FiniteHigh = std::max(this->FiniteHigh, v);
+    this->AnyFinite = true;
+  }
+
+  void Merge(const Extremes& o)
+  {
+    this->AllLow = std::min(this->AllLow, o.AllLow);
+    this->AllHigh = std::max(this->AllHigh, o.AllHigh);
+    this->FiniteLow = std::min(this->FiniteLow, o.FiniteLow);
+    this->FiniteHigh = std::max(this->FiniteHigh, o.FiniteHigh);
+    this->AnyValue = this->AnyValue || o.AnyValue;
+    this->AnyFinite = this->AnyFinite || o.AnyFinite;
+  }
+};
+
+/// Every component's extremes; the minimum and maximum do not depend on how the tuples are cut
+/// into chunks, so neither do the results on the threads.
+template <typename T>
+std::vector<Extremes<T>> ComponentExtremes(const T* values, vtkIdType tuples, int components)
+{
+  constexpr vtkIdType Chunk = vtkIdType(1) << 18;
+  const vtkIdType chunks = (tuples + Chunk - 1) / Chunk;
+  std::vector<Extremes<T>> partial(static_cast<std::size_t>(chunks * components));
+  rgmc::ParallelFor(chunks, 1,
+    [&](vtkIdType first, vtkIdType last)
+    {
+      for (vtkIdType c = first; c < last; ++c)
+      {
+        Extremes<T>* e = partial.data() + c * components;
+        const vtkIdType end = std::min(tuples, (c + 1) * Chunk);
+        const T* v = values + c * Chunk * components;
+        for (vtkIdType t = c * Chunk; t < end; ++t)
+        {
+          for (int k = 0; k < components; ++k)
+          {
+            e[k].Add(*v++);
+          }
+        }
+      }
+    });
+  std::vector<Extremes<T>> result(static_cast<std::size_t>(components));
+  for (vtkIdType c = 0; c < chunks; ++c)
+  {
+    for (int k = 0; k < components; ++k)
+    {
+      result[k].Merge(partial[c * components + k]);
+    }
+  }
+  return result;
+}
+
+template <typename T>
+void StoreRanges(vtkDataArray* array, const T* values)
+{
+  const int components = array->GetNumberOfComponents();
+  const auto extremes = ComponentExtremes(values, array->GetNumberOfTuples(), components);
+  for (const auto& e : extremes)
+  {
+    if (!e.AnyValue || !e.AnyFinite)
+    {
+      return; // VTK's own scan decides what such a component's range is
+    }
+  }
+  vtkNew<vtkInformationVector> all, finite;
+  all->SetNumberOfInformationObjects(components);
+  finite->SetNumberOfInformationObjects(components);
+  for (int k = 0; k < components; ++k)
+  {
+    const double a[2] = { double(extremes[k].AllLow), double(extremes[k].AllHigh) };
+    const double f[2] = { double(extremes[k].FiniteLow), double(extremes[k].FiniteHigh) };
+    all->GetInformationObject(k)->Set(vtkDataArray::COMPONENT_RANGE(), a, 2);
+    finite->GetInformationObject(k)->Set(vtkDataArray::COMPONENT_RANGE(), f, 2);
+  }
+  vtkInformation* info = array->GetInformation();
+  info->Set(vtkAbstractArray::PER_COMPONENT(), all);
+  info->Set(vtkAbstractArray::PER_FINITE_COMPONENT(), finite);
+}
+
+} // namespace
+
+namespace rgmc
+{
+
+void CacheRanges(vtkDataArray* array)
+{
+  if (!array || array->GetNumberOfTuples() == 0 || array->GetNumberOfComponents() < 1 ||
+    !array->HasStandardMemoryLayout() || array->GetDataType() == VTK_BIT)
+  {
+    return;
+  }
+  switch (array->GetDataType())
+  {
+    vtkTemplateMacro(StoreRanges(array, static_cast<const VTK_TT*>(array->GetVoidPointer(0))));
+    default:
+      break;
+  }
+}
+
+} // namespace rgmc
