@@ -540,6 +540,14 @@ bool vtkRGDICOMSeriesReader::Parse(const std::vector<vtkIdType>& header, std::st
 }
 
 //------------------------------------------------------------------------------
+int vtkRGDICOMSeriesReader::RequestData(
+  vtkInformation* request, vtkInformationVector** inputs, vtkInformationVector* outputs)
+{
+  this->NumberOfFilesRead = 0; // counted over the ReadExtent calls of this update
+  return this->Superclass::RequestData(request, inputs, outputs);
+}
+
+//------------------------------------------------------------------------------
 // No collective call here: vtkRGVolumeReader's RequestData agrees on the status over all ranks.
 bool vtkRGDICOMSeriesReader::ReadExtent(
   const int extent[6], vtkDataArray* scalars, std::string& message)
@@ -552,7 +560,6 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
   rgmc::DecodedFile decoded;
   decoded.Planar = pixels.Planar;
   vtkIdType at = 0;
-  this->NumberOfFilesRead = 0;
   for (int k = extent[4]; k <= extent[5]; ++k)
   {
     // PASS 1, once per file: decode every frame of the slice's file.

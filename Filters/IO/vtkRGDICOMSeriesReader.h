@@ -83,7 +83,8 @@ public:
   ///@}
 
   /**
-   * How many files this rank decoded in its last update: the files of its own slices only.
+   * How many files this rank decoded in its last update: the files of its own slices only, and
+   * of those only the ones the piece it held before did not have.
    */
   int GetNumberOfFilesRead() const { return this->NumberOfFilesRead; }
 
@@ -94,6 +95,7 @@ protected:
   bool Scan(std::vector<vtkIdType>& header, std::string& message) override;
   bool Parse(const std::vector<vtkIdType>& header, std::string& message) override;
   bool ReadExtent(const int extent[6], vtkDataArray* scalars, std::string& message) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   char* SeriesInstanceUID = nullptr;
   std::string SeriesList;

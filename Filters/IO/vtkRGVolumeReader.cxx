@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 //------------------------------------------------------------------------------
@@ -221,6 +222,16 @@ int vtkRGVolumeReader::RequestData(
   }
   std::string message;
   bool ok = true;
+  // The piece read last, when nothing has changed since: ParaView reads a piece without ghost
+  // layers first and asks again with them once a filter needs them (RG Marching Cubes does), so
+  // the slices the two share are copied instead of read and decoded again. Until the new piece
+  // is complete both are in memory.
+  vtkSmartPointer<vtkDataArray> previous;
+  if (this->ReadTime > this->GetMTime() && this->ReadTime > this->ScanTime)
+  {
+    previous = this->LastPiece;
+  }
+  this->LastPiece = nullptr;
   vtkSmartPointer<vtkDataArray> scalars;
   output->Initialize();
   output->SetSpacing(this->Spacing);
@@ -235,7 +246,7 @@ int vtkRGVolumeReader::RequestData(
     scalars->SetNumberOfTuples(output->GetNumberOfPoints());
     try
     {
-      ok = this->ReadExtent(extent, scalars, message);
+      ok = this->ReadReusing(extent, scalars, previous, this->LastExtent, message);
     }
     catch (const std::exception& e)
     {
@@ -253,6 +264,9 @@ int vtkRGVolumeReader::RequestData(
   }
   if (!empty)
   {
+    this->LastPiece = scalars;
+    std::copy(extent, extent + 6, this->LastExtent);
+    this->ReadTime.Modified();
     rgmc::CacheRanges(scalars);
     output->GetPointData()->SetScalars(scalars);
     // Mark the ghost layers the pipeline asked for, as ParaView's image sources do, so that
@@ -263,6 +277,51 @@ int vtkRGVolumeReader::RequestData(
     }
   }
   return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkRGVolumeReader::ReadReusing(const int extent[6], vtkDataArray* scalars,
+  vtkDataArray* previous, const int previousExtent[6], std::string& message)
+{
+  const bool sameRows = previous && previous->GetDataType() == scalars->GetDataType() &&
+    previous->GetNumberOfComponents() == scalars->GetNumberOfComponents() &&
+    std::equal(extent, extent + 4, previousExtent);
+  const int lo = std::max(extent[4], previousExtent[4]);
+  const int hi = std::min(extent[5], previousExtent[5]);
+  if (!sameRows || lo > hi)
+  {
+    return this->ReadExtent(extent, scalars, message);
+  }
+  const std::size_t sliceBytes = static_cast<std::size_t>(extent[1] - extent[0] + 1) *
+    static_cast<std::size_t>(extent[3] - extent[2] + 1) *
+    static_cast<std::size_t>(scalars->GetNumberOfComponents() * scalars->GetDataTypeSize());
+  auto* to = static_cast<unsigned char*>(scalars->GetVoidPointer(0));
+  const auto* from = static_cast<const unsigned char*>(previous->GetVoidPointer(0));
+  std::memcpy(to + (lo - extent[4]) * sliceBytes, from + (lo - previousExtent[4]) * sliceBytes,
+    static_cast<std::size_t>(hi - lo + 1) * sliceBytes);
+  // The slices before and after the shared ones, each run read on its own and copied in.
+  const int runs[2][2] = { { extent[4], lo - 1 }, { hi + 1, extent[5] } };
+  for (const auto& run : runs)
+  {
+    if (run[0] > run[1])
+    {
+      continue;
+    }
+    const int part[6] = { extent[0], extent[1], extent[2], extent[3], run[0], run[1] };
+    vtkSmartPointer<vtkDataArray> read;
+    read.TakeReference(vtkDataArray::CreateDataArray(scalars->GetDataType()));
+    read->SetNumberOfComponents(scalars->GetNumberOfComponents());
+    read->SetNumberOfTuples(static_cast<vtkIdType>(sliceBytes /
+                              (scalars->GetDataTypeSize() * scalars->GetNumberOfComponents())) *
+      (run[1] - run[0] + 1));
+    if (!this->ReadExtent(part, read, message))
+    {
+      return false;
+    }
+    std::memcpy(to + (run[0] - extent[4]) * sliceBytes, read->GetVoidPointer(0),
+      static_cast<std::size_t>(run[1] - run[0] + 1) * sliceBytes);
+  }
+  return true;
 }
 
 //------------------------------------------------------------------------------

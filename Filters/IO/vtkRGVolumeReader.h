@@ -35,6 +35,7 @@
 
 #include "RGMCIOModule.h" // For export macro
 #include "vtkImageAlgorithm.h"
+#include "vtkSmartPointer.h" // For LastPiece
 
 #include <string> // For std::string
 #include <vector> // For the header
@@ -148,7 +149,18 @@ private:
   vtkRGVolumeReader(const vtkRGVolumeReader&) = delete;
   void operator=(const vtkRGVolumeReader&) = delete;
 
+  /// Fills `scalars` for `extent` as ReadExtent does, copying the slices it shares with
+  /// `previous` (the piece read last, of `previousExtent`; null when there is none to use) and
+  /// reading only the others.
+  bool ReadReusing(const int extent[6], vtkDataArray* scalars, vtkDataArray* previous,
+    const int previousExtent[6], std::string& message);
+
   vtkTimeStamp ScanTime;
+  // The piece of the last successful read (the output's own array: the pipeline empties the
+  // output before it asks for the next piece), its extent, and when it was read.
+  vtkSmartPointer<vtkDataArray> LastPiece;
+  int LastExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  vtkTimeStamp ReadTime;
 };
 
 #endif

@@ -238,6 +238,10 @@ int vtkRGPhantomSource::RequestInformation(
 //------------------------------------------------------------------------------
 void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo)
 {
+  if (this->MadeTime < this->GetMTime())
+  {
+    this->LastPiece = nullptr; // changed since: of no use, and not to be held while allocating
+  }
   vtkImageData* image = this->AllocateOutputData(output, outInfo);
   vtkShortArray* hu = vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars());
   if (!hu)
@@ -254,9 +258,18 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
   const std::uint64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
   const vtkIdType slice = vtkIdType(ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1);
   short* out = hu->GetPointer(0);
+  // The slices shared with the piece made last, when nothing has changed since, are copied.
+  vtkSmartPointer<vtkShortArray> previous;
+  if (this->LastPiece && this->LastPiece != hu && std::equal(ext, ext + 4, this->LastExtent))
+  {
+    previous = this->LastPiece;
+  }
+  this->LastPiece = nullptr;
+  const int* last = this->LastExtent;
   // Every voxel is a function of its index alone, so the slices are made on the threads with
   // the same result; progress and abort are checked between waves of slices, on this thread.
   const int wave = 4 * std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads());
+  bool aborted = false;
   for (int first = ext[4]; first <= ext[5]; first += wave)
   {
     if (ext[5] > ext[4])
@@ -265,16 +278,23 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
     }
     if (this->CheckAbort())
     {
+      aborted = true;
       break;
     }
-    const int last = std::min(ext[5], first + wave - 1);
-    rgmc::ParallelFor(last - first + 1, 1,
-      [&](vtkIdType begin, vtkIdType end)
+    const int end = std::min(ext[5], first + wave - 1);
+    rgmc::ParallelFor(end - first + 1, 1,
+      [&](vtkIdType begin, vtkIdType stop)
       {
-        for (vtkIdType s = begin; s < end; ++s)
+        for (vtkIdType s = begin; s < stop; ++s)
         {
           const int k = first + static_cast<int>(s);
           short* v = out + (k - ext[4]) * slice;
+          if (previous && k >= last[4] && k <= last[5])
+          {
+            const short* from = previous->GetPointer(0) + (k - last[4]) * slice;
+            std::copy(from, from + slice, v);
+            continue;
+          }
           for (int j = ext[2]; j <= ext[3]; ++j)
           {
             for (int i = ext[0]; i <= ext[1]; ++i)
@@ -284,6 +304,12 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
           }
         }
       });
+  }
+  if (!aborted)
+  {
+    this->LastPiece = hu;
+    std::copy(ext, ext + 6, this->LastExtent);
+    this->MadeTime.Modified();
   }
   rgmc::CacheRanges(hu);
 }

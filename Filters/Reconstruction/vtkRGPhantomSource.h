@@ -25,6 +25,8 @@
 
 #include "RGMCReconstructionModule.h" // For export macro
 #include "vtkImageAlgorithm.h"
+#include "vtkShortArray.h"   // For LastPiece
+#include "vtkSmartPointer.h" // For LastPiece
 
 #include <cstdint> // For std::uint64_t
 
@@ -93,6 +95,13 @@ private:
   /// The voxel (i, j, k) in HU, noise included, clamped and rounded to int16.
   short Sample(const double origin[3], const double spacing[3], int i, int j, int k,
     std::uint64_t nx, std::uint64_t ny) const;
+
+  // The piece made last (the output's own array: the pipeline empties the output before it
+  // asks for the next piece), its extent, and when it was made: a piece asked for again with
+  // ghost layers copies the slices the two share.
+  vtkSmartPointer<vtkShortArray> LastPiece;
+  int LastExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  vtkTimeStamp MadeTime;
 };
 
 #endif
