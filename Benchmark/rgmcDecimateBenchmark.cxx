@@ -5,12 +5,15 @@
 //
 // The CT phantom's skull (`size`^3, seeded at 400 HU, Seam Repair with 20 Laplacian iterations)
 // reduced by vtkRGDecimate on R ranks at each thread count, and, on one rank when --vtk is 1, by
-// vtkQuadricDecimation and vtkDecimatePro (PreserveTopology on, so that it may not reach the
-// target) on the same merged mesh in the same run. For each: seconds (the slowest rank's, the
-// fastest of `repeats`), triangles, the symmetric Hausdorff and mean distances to the undecimated
-// surface (sampled at the vertices of each surface, to the other surface, in voxels), and whether
-// the output is closed (every edge in exactly two triangles, once each way). Each rank builds
-// only its block of the volume. Prints one JSON object per line on rank 0.
+// vtkQuadricDecimation, vtkDecimatePro (PreserveTopology on, so that it may not reach the
+// target) and, where Debian's libmeshoptimizer-dev was found at configure time,
+// meshopt_simplify (one thread, an error bound that never stops it before the target count) on
+// the same merged mesh in the same run. For each: seconds (the slowest rank's, the fastest of
+// `repeats`), triangles, the symmetric Hausdorff and mean distances to the undecimated surface
+// (sampled at the vertices of each surface, to the other surface, in voxels), the parts (sets
+// of triangles joined through shared edges) and whether the output is closed (every edge in
+// exactly two triangles, once each way). Each rank builds only its block of the volume. Prints
+// one JSON object per line on rank 0.
 #include "rgmcBenchmark.h"        // Now, IntList
 #include "rgmcDistributedData.h"  // BlockPiece, PhantomPiece, MarkGhostCells
 #include "rgmcNearestDistances.h" // Nearest
@@ -30,10 +33,18 @@
 #include "vtkQuadricDecimation.h"
 #include "vtkSMPTools.h"
 
+#ifdef RGMC_HAVE_MESHOPTIMIZER
+#include <meshoptimizer.h>
+#define RGMC_TEXT(x) #x
+#define RGMC_VERSION_TEXT(v) RGMC_TEXT(v)
+#define MESHOPT_VERSION_TEXT RGMC_VERSION_TEXT(MESHOPTIMIZER_VERSION)
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -134,6 +145,114 @@ bool Closed(vtkPolyData* pd)
   return true;
 }
 
+/// How many parts `pd` falls into: triangles joined when they share an edge (admesh's count).
+vtkIdType Parts(vtkPolyData* pd)
+{
+  const vtkIdType triangles = pd->GetNumberOfCells();
+  std::vector<vtkIdType> parent(static_cast<std::size_t>(triangles));
+  std::iota(parent.begin(), parent.end(), vtkIdType(0));
+  auto root = [&parent](vtkIdType t)
+  {
+    while (parent[t] != t)
+    {
+      t = parent[t] = parent[parent[t]];
+    }
+    return t;
+  };
+  std::vector<std::array<vtkIdType, 3>> edges; // lower point, higher point, triangle
+  for (vtkIdType t = 0; t < triangles; ++t)
+  {
+    vtkIdType n;
+    const vtkIdType* pts;
+    pd->GetCellPoints(t, n, pts);
+    for (vtkIdType k = 0; k < n; ++k)
+    {
+      const vtkIdType a = pts[k], b = pts[(k + 1) % n];
+      edges.push_back({ std::min(a, b), std::max(a, b), t });
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t e = 1; e < edges.size(); ++e)
+  {
+    if (edges[e][0] == edges[e - 1][0] && edges[e][1] == edges[e - 1][1])
+    {
+      parent[root(edges[e][2])] = root(edges[e - 1][2]);
+    }
+  }
+  vtkIdType parts = 0;
+  for (vtkIdType t = 0; t < triangles; ++t)
+  {
+    parts += root(t) == t;
+  }
+  return parts;
+}
+
+#ifdef RGMC_HAVE_MESHOPTIMIZER
+/// meshopt_simplify on `original` to (1 - reduction) of its triangles, the fastest of `repeats`
+/// runs in `seconds`; the result with only the vertices its triangles use.
+vtkSmartPointer<vtkPolyData> MeshoptSimplify(
+  vtkPolyData* original, double reduction, int repeats, double& seconds)
+{
+  const vtkIdType points = original->GetNumberOfPoints(), cells = original->GetNumberOfCells();
+  std::vector<float> xyz(static_cast<std::size_t>(3 * points));
+  for (vtkIdType p = 0; p < points; ++p)
+  {
+    double x[3];
+    original->GetPoint(p, x);
+    for (int a = 0; a < 3; ++a)
+    {
+      xyz[3 * p + a] = static_cast<float>(x[a]);
+    }
+  }
+  std::vector<unsigned int> indices;
+  indices.reserve(static_cast<std::size_t>(3 * cells));
+  for (vtkIdType t = 0; t < cells; ++t)
+  {
+    vtkIdType n;
+    const vtkIdType* pts;
+    original->GetCellPoints(t, n, pts);
+    indices.insert(indices.end(),
+      { static_cast<unsigned int>(pts[0]), static_cast<unsigned int>(pts[1]),
+        static_cast<unsigned int>(pts[2]) });
+  }
+  const std::size_t target = 3 * static_cast<std::size_t>(std::llround((1 - reduction) * cells));
+  std::vector<unsigned int> kept(indices.size());
+  std::size_t count = 0;
+  seconds = 1e300;
+  for (int r = 0; r < std::max(1, repeats); ++r)
+  {
+    const double start = Now();
+    count = meshopt_simplify(kept.data(), indices.data(), indices.size(), xyz.data(),
+      static_cast<std::size_t>(points), 3 * sizeof(float), target, 1.0f, 0, nullptr);
+    seconds = std::min(seconds, Now() - start);
+  }
+  std::map<unsigned int, vtkIdType> used;
+  vtkNew<vtkPoints> out;
+  out->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> polys;
+  for (std::size_t i = 0; i < count; i += 3)
+  {
+    vtkIdType ids[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      auto at = used.find(kept[i + k]);
+      if (at == used.end())
+      {
+        double x[3];
+        original->GetPoint(kept[i + k], x);
+        at = used.emplace(kept[i + k], out->InsertNextPoint(x)).first;
+      }
+      ids[k] = at->second;
+    }
+    polys->InsertNextCell(3, ids);
+  }
+  auto result = vtkSmartPointer<vtkPolyData>::New();
+  result->SetPoints(out);
+  result->SetPolys(polys);
+  return result;
+}
+#endif
+
 /// One JSON line for a decimated surface against the original.
 std::string Row(const std::string& method, int ranks, int threads, double seconds,
   vtkPolyData* original, vtkPolyData* decimated, double voxel)
@@ -147,6 +266,7 @@ std::string Row(const std::string& method, int ranks, int threads, double second
      << ", \"triangles\": " << decimated->GetNumberOfCells()
      << ", \"hausdorff_voxels\": " << std::max(there, back) / voxel
      << ", \"mean_voxels\": " << 0.5 * (thereMean + backMean) / voxel
+     << ", \"parts\": " << Parts(decimated)
      << ", \"closed\": " << (Closed(decimated) ? "true" : "false") << "}";
   return os.str();
 }
@@ -256,6 +376,14 @@ int main(int argc, char* argv[])
     const double proSeconds = rgmc_benchmark::FastestUpdate(1, pro.Get());
     std::cout << Row("vtkDecimatePro", 1, 1, proSeconds, original, pro->GetOutput(), voxel)
               << std::endl;
+#ifdef RGMC_HAVE_MESHOPTIMIZER
+    double meshoptSeconds = 0;
+    vtkSmartPointer<vtkPolyData> simplified =
+      MeshoptSimplify(original, reduction, repeats, meshoptSeconds);
+    std::cout << Row("meshopt_simplify " MESHOPT_VERSION_TEXT, 1, 1, meshoptSeconds, original,
+                   simplified, voxel)
+              << std::endl;
+#endif
   }
   controller->Finalize();
   return 0;
