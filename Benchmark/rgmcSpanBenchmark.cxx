@@ -54,12 +54,12 @@ double FaultCost()
   double best = 1e300;
   for (int r = 0; r < 3; ++r)
   {
-    std::unique_ptr<char[]> fresh(new char[bytes]);
+    std::unique_ptr<unsigned char[]> fresh(new unsigned char[bytes]);
     const long long before = MinorFaults();
     const double start = Now();
     for (std::size_t b = 0; b < bytes; b += 4096)
     {
-      fresh[b] = static_cast<char>(b);
+      fresh[b] = static_cast<unsigned char>(b);
     }
     const double took = Now() - start;
     const long long faults = MinorFaults() - before;

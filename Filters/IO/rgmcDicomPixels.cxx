@@ -67,12 +67,12 @@ bool ReadNativePixels(const std::string& path, const PixelDescription& pixels,
     swap && expected % word != 0 && structure.PixelDataLength >= expected + word - expected % word
     ? expected + word - expected % word
     : expected;
-  std::vector<char>& buffer = decoded.Bytes;
+  std::vector<unsigned char>& buffer = decoded.Bytes;
   std::ifstream file(path, std::ios::binary);
   buffer.assign(padded, 0);
   file.seekg(static_cast<std::streamoff>(structure.PixelDataOffset));
-  const bool read =
-    static_cast<bool>(file.read(buffer.data(), static_cast<std::streamsize>(padded)));
+  const bool read = static_cast<bool>(
+    file.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(padded)));
   if (swap)
   {
     for (std::size_t b = 0; b + word <= buffer.size(); b += word)
@@ -122,12 +122,11 @@ bool CheckJpegFrames(const std::string& path, const PixelDescription& pixels,
   for (const auto& fragment : structure.Fragments)
   {
     std::string why;
-    char start[2] = { 0, 0 };
+    unsigned char start[2] = { 0, 0 };
     std::ifstream file(path, std::ios::binary);
     file.seekg(static_cast<std::streamoff>(fragment.first));
-    file.read(start, 2);
-    const bool frameStart =
-      static_cast<unsigned char>(start[0]) == 0xff && static_cast<unsigned char>(start[1]) == 0xd8;
+    file.read(reinterpret_cast<char*>(start), 2);
+    const bool frameStart = start[0] == 0xff && start[1] == 0xd8;
     if ((frameStart || &fragment == &structure.Fragments.front()) &&
       !rgmc::CheckJpegHeader(path, fragment.first, fragment.second, pixels.Rows, pixels.Columns,
         pixels.Samples, pixels.BitsStored, why))
@@ -197,7 +196,7 @@ bool DecodeWithGdcm(const std::string& path, const PixelDescription& pixels,
     DescribeImage(pixels, reader.GetFile(), image);
     decoded.Bytes.assign(
       std::max<std::size_t>(image.GetBufferLength(), frameBytes * pixels.Frames), 0);
-    const bool ok = image.GetBuffer(decoded.Bytes.data());
+    const bool ok = image.GetBuffer(reinterpret_cast<char*>(decoded.Bytes.data()));
     // A codec may hand back interleaved samples whatever the header said.
     decoded.Planar = pixels.Samples == 3 ? static_cast<int>(image.GetPlanarConfiguration()) : 0;
     return ok;

@@ -33,9 +33,9 @@ int ColourScalarType(int bitsAllocated);
 /// The pixel data of the file decoded last (a multi-frame file serves several slices).
 struct DecodedFile
 {
-  std::string Path;        // empty before the first file
-  std::vector<char> Bytes; // every frame, samples in this host's byte order
-  int Planar = 0;          // the planar configuration of Bytes (a codec may interleave samples)
+  std::string Path;                 // empty before the first file
+  std::vector<unsigned char> Bytes; // every frame, samples in this host's byte order
+  int Planar = 0; // the planar configuration of Bytes (a codec may interleave samples)
 };
 
 /// Bytes of one decoded frame: decoders give full frames; native YBR_FULL_422 stays subsampled
@@ -85,11 +85,12 @@ private:
 
 /// The stored value of the sample at `index` of a decoded frame: its stored bits, sign-extended
 /// from the highest one when the samples are signed.
-inline double StoredSample(const PixelDescription& pixels, const char* frame, std::size_t index)
+inline double StoredSample(
+  const PixelDescription& pixels, const unsigned char* frame, std::size_t index)
 {
   if (pixels.BitsAllocated == 1)
   {
-    return (static_cast<unsigned char>(frame[index / 8]) >> (index % 8)) & 1;
+    return (frame[index / 8] >> (index % 8)) & 1;
   }
   const std::size_t bytes = pixels.BitsAllocated / 8;
   std::uint32_t raw = 0;

@@ -513,7 +513,7 @@ bool CheckJpegHeader(const std::string& path, std::uint64_t offset, std::uint64_
 }
 
 bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t length,
-  std::size_t pixels, int samples, int bytes, char* out, std::string& problem)
+  std::size_t pixels, int samples, int bytes, unsigned char* out, std::string& problem)
 {
   Source source(path);
   std::vector<unsigned char> data(static_cast<std::size_t>(length));
@@ -552,7 +552,7 @@ bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t
     {
       if (pixel < pixels)
       {
-        out[(pixel * samples + sample) * bytes + byte] = static_cast<char>(v);
+        out[(pixel * samples + sample) * bytes + byte] = v;
       }
       ++pixel;
     };

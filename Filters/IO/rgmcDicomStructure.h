@@ -50,7 +50,7 @@ bool CheckJpegHeader(const std::string& path, std::uint64_t offset, std::uint64_
 /// bytes in `path`, into `out` (pixels * samples samples of `bytes` bytes each, interleaved, this
 /// host's byte order). False with `problem` when the frame is malformed.
 bool DecodeRleFrame(const std::string& path, std::uint64_t offset, std::uint64_t length,
-  std::size_t pixels, int samples, int bytes, char* out, std::string& problem);
+  std::size_t pixels, int samples, int bytes, unsigned char* out, std::string& problem);
 
 } // namespace rgmc
 

@@ -573,7 +573,7 @@ bool vtkRGDICOMSeriesReader::ReadExtent(
       ++this->NumberOfFilesRead;
     }
     // PASS 2: the rows of the extent in the slice's frame, rescaled (one sample per pixel).
-    const char* frame = decoded.Bytes.data() + frameBytes * slice.Frame;
+    const unsigned char* frame = decoded.Bytes.data() + frameBytes * slice.Frame;
     const rgmc::FrameLayout layout(pixels, decoded.Planar);
     for (int j = extent[2]; j <= extent[3]; ++j)
     {

@@ -48,7 +48,7 @@ public:
   GzFile& operator=(const GzFile&) = delete;
 
   /// Reads `count` bytes from `offset` on; returns how many it read (-1 on a zlib error).
-  long long Read(std::uint64_t offset, char* out, std::uint64_t count)
+  long long Read(std::uint64_t offset, unsigned char* out, std::uint64_t count)
   {
     if (gzseek(this->File, static_cast<z_off_t>(offset), SEEK_SET) < 0)
     {
@@ -81,7 +81,7 @@ public:
   gzFile File;
 };
 
-void SwapBytes(char* data, int size)
+void SwapBytes(unsigned char* data, int size)
 {
   std::reverse(data, data + size);
 }
@@ -98,10 +98,10 @@ struct Header
 };
 
 template <typename T>
-T Field(const char* raw, int offset, bool swap)
+T Field(const unsigned char* raw, int offset, bool swap)
 {
   T value;
-  char bytes[sizeof(T)];
+  unsigned char bytes[sizeof(T)];
   std::memcpy(bytes, raw + offset, sizeof(T));
   if (swap)
   {
@@ -112,7 +112,7 @@ T Field(const char* raw, int offset, bool swap)
 }
 
 /// Parses a 348-byte header; false with `problem` when it is not a single-file NIfTI-1 header.
-bool ParseHeader(const char* raw, Header& h, std::string& problem)
+bool ParseHeader(const unsigned char* raw, Header& h, std::string& problem)
 {
   const std::int32_t size = Field<std::int32_t>(raw, 0, false);
   const std::int32_t swapped = Field<std::int32_t>(raw, 0, true);
@@ -224,13 +224,13 @@ std::string DataTypeName(int datatype)
 }
 
 template <typename T>
-double Value(const char* p, bool swap)
+double Value(const unsigned char* p, bool swap)
 {
   return static_cast<double>(Field<T>(p, 0, swap));
 }
 
 /// One stored voxel as a double.
-double Voxel(const char* p, int vtkType, bool swap)
+double Voxel(const unsigned char* p, int vtkType, bool swap)
 {
   switch (vtkType)
   {
@@ -275,7 +275,7 @@ int vtkRGNIfTIReader::CanReadFile(const char* name)
     return 0;
   }
   GzFile file(name);
-  char raw[HeaderSize];
+  unsigned char raw[HeaderSize];
   Header h;
   std::string problem;
   return file.File && file.Read(0, raw, HeaderSize) == HeaderSize && ParseHeader(raw, h, problem)
@@ -317,7 +317,7 @@ bool ReadHeader(VolumeScan& scan, std::string& message)
     return false;
   }
   GzFile file(scan.Path);
-  char raw[HeaderSize];
+  unsigned char raw[HeaderSize];
   const long long got = file.File ? file.Read(0, raw, HeaderSize) : -1;
   if (got < 0)
   {
@@ -715,7 +715,7 @@ bool vtkRGNIfTIReader::ReadExtent(const int extent[6], vtkDataArray* scalars, st
   const int bytes = this->BytesPerVoxel;
   const int width = extent[1] - extent[0] + 1;
   const int rows = extent[3] - extent[2] + 1;
-  std::vector<char> chunk(static_cast<std::size_t>(rows) * nx * bytes);
+  std::vector<unsigned char> chunk(static_cast<std::size_t>(rows) * nx * bytes);
   std::vector<double> values(static_cast<std::size_t>(width));
   vtkIdType at = 0;
   // PASS: slice by slice, the rows of the extent in one read each (increasing offsets, so a
@@ -740,7 +740,8 @@ bool vtkRGNIfTIReader::ReadExtent(const int extent[6], vtkDataArray* scalars, st
     }
     for (int j = 0; j < rows; ++j)
     {
-      const char* row = chunk.data() + (static_cast<std::size_t>(j) * nx + extent[0]) * bytes;
+      const unsigned char* row =
+        chunk.data() + (static_cast<std::size_t>(j) * nx + extent[0]) * bytes;
       for (int i = 0; i < width; ++i)
       {
         values[i] = this->RescaleSlope *

@@ -290,7 +290,7 @@ public:
     }
     std::vector<Triangle> byId(this->NumberOfTriangles());
     VertexTable vertices;
-    std::vector<char> used(this->NumberOfVertices(), 0);
+    std::vector<std::uint8_t> used(this->NumberOfVertices(), 0);
     for (std::size_t t = 0; t < byId.size(); ++t)
     {
       vtkIdType c[3];

@@ -144,7 +144,7 @@ void SimplifyBlock(Block& block, double maximumError, std::size_t maximumCollaps
   {
     block.Levels[c] = block.Log[c].Level;
   }
-  std::vector<char> used(block.Mesh.Ids.size(), 0);
+  std::vector<std::uint8_t> used(block.Mesh.Ids.size(), 0);
   for (const auto& t : block.Mesh.Triangles)
   {
     used[t[0]] = used[t[1]] = used[t[2]] = 1;
@@ -192,7 +192,7 @@ public:
       this->Surface.reserve(this->Expected);
       this->Vertices.Reserve(this->Expected / 2 + this->Expected / 16);
     }
-    std::vector<std::vector<char>> used(static_cast<std::size_t>(last - first));
+    std::vector<std::vector<std::uint8_t>> used(static_cast<std::size_t>(last - first));
     rgmc::ParallelFor(static_cast<vtkIdType>(last - first), 1,
       [&](vtkIdType from, vtkIdType to)
       {
@@ -216,7 +216,7 @@ public:
       const std::size_t b = static_cast<std::size_t>(block - first);
       this->Copy(*block, used[b]);
       *block = Block{ block->Id, block->Wave, {}, {}, {}, {}, {}, 0, 0, 0 };
-      std::vector<char>().swap(used[b]);
+      std::vector<std::uint8_t>().swap(used[b]);
     }
   }
 
@@ -227,7 +227,7 @@ public:
   std::size_t Expected = 0;      // triangles, to size the lists once
 
 private:
-  void Copy(const Block& block, const std::vector<char>& used)
+  void Copy(const Block& block, const std::vector<std::uint8_t>& used)
   {
     this->Kept += static_cast<vtkIdType>(block.Keep);
     if (block.Keep > 0)
@@ -507,7 +507,7 @@ void vtkRGDecimate::ReadPartBounds(Run& run, double bounds[6])
 {
   SurfacePart& part = run.Part;
   part.Read(run.Input);
-  std::vector<char> used(part.NumberOfVertices(), 0);
+  std::vector<std::uint8_t> used(part.NumberOfVertices(), 0);
   for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
   {
     vtkIdType c[3];

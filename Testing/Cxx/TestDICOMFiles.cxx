@@ -55,16 +55,18 @@ std::vector<Entry> Manifest(const std::string& path)
 }
 
 /// The file's bytes.
-std::vector<char> Bytes(const std::string& path)
+std::vector<unsigned char> Bytes(const std::string& path)
 {
   std::ifstream in(path, std::ios::binary);
-  return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return std::vector<unsigned char>(
+    std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-void Save(const std::string& path, const std::vector<char>& bytes)
+void Save(const std::string& path, const std::vector<unsigned char>& bytes)
 {
   std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.write(
+    reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
 std::vector<double> Samples(const std::string& path)
@@ -176,43 +178,43 @@ int main()
   struct Quirk
   {
     std::string Name;
-    std::vector<char> Tail;
+    std::vector<unsigned char> Tail;
   };
   const std::vector<std::pair<std::string, std::string>> files = { { "CT_small.dcm", "explicit" },
     { "MR_small_implicit.dcm", "implicit" }, { "MR_small_bigendian.dcm", "big" } };
   for (const auto& file : files)
   {
     const std::string name = file.first, syntax = file.second;
-    const std::vector<char> original = Bytes(std::string(RGMC_PYDICOM_DIR) + "/" + name);
+    const std::vector<unsigned char> original = Bytes(std::string(RGMC_PYDICOM_DIR) + "/" + name);
     const std::vector<double> theirs = Samples(oracle + "/" + name + ".f64");
     // Data Set Trailing Padding (FFFC,FFFC), OB, 6 bytes, in the file's own syntax.
-    std::vector<char> padding;
+    std::vector<unsigned char> padding;
     if (syntax == "big")
     {
-      padding = { '\xff', '\xfc', '\xff', '\xfc', 'O', 'B', 0, 0, 0, 0, 0, 6, 0, 0, 0, 0, 0, 0 };
+      padding = { 0xff, 0xfc, 0xff, 0xfc, 'O', 'B', 0, 0, 0, 0, 0, 6, 0, 0, 0, 0, 0, 0 };
     }
     else if (syntax == "explicit")
     {
-      padding = { '\xfc', '\xff', '\xfc', '\xff', 'O', 'B', 0, 0, 6, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+      padding = { 0xfc, 0xff, 0xfc, 0xff, 'O', 'B', 0, 0, 6, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
     }
     else
     {
-      padding = { '\xfc', '\xff', '\xfc', '\xff', 6, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+      padding = { 0xfc, 0xff, 0xfc, 0xff, 6, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
     }
-    std::vector<char> junk(3001);
+    std::vector<unsigned char> junk(3001);
     std::uint32_t state = 20261123;
-    for (char& c : junk)
+    for (unsigned char& c : junk)
     {
       state = state * 1664525u + 1013904223u;
-      c = static_cast<char>(state >> 24);
+      c = static_cast<unsigned char>(state >> 24);
     }
     const std::vector<Quirk> quirks = { { "2.5 MB of zero bytes after the pixel data",
-                                          std::vector<char>(2500000, 0) },
+                                          std::vector<unsigned char>(2500000, 0) },
       { "Data Set Trailing Padding (FFFC,FFFC)", padding },
       { "3001 bytes of junk after the pixel data", junk } };
     for (const Quirk& q : quirks)
     {
-      std::vector<char> bytes = original;
+      std::vector<unsigned char> bytes = original;
       bytes.insert(bytes.end(), q.Tail.begin(), q.Tail.end());
       const std::string dir = work + "/quirk-" + std::to_string(&q - quirks.data()) + "-" + name;
       fs::create_directories(dir);
@@ -280,11 +282,11 @@ int main()
     // No preamble, no "DICM", no file meta information: MR_small_implicit.dcm's bare data set
     // (implicit VR little endian), as older archives hold them.
     const std::string name = "MR_small_implicit.dcm";
-    const std::vector<char> original = Bytes(std::string(RGMC_PYDICOM_DIR) + "/" + name);
+    const std::vector<unsigned char> original = Bytes(std::string(RGMC_PYDICOM_DIR) + "/" + name);
     // (0002,0000) UL, explicit VR little endian, right after "DICM": the meta group's length.
     std::uint32_t metaLength = 0;
     std::memcpy(&metaLength, original.data() + 132 + 8, 4);
-    const std::vector<char> bare(original.begin() + 132 + 12 + metaLength, original.end());
+    const std::vector<unsigned char> bare(original.begin() + 132 + 12 + metaLength, original.end());
     const std::string dir = work + "/bare-" + name;
     fs::create_directories(dir);
     Save(dir + "/" + name, bare);
@@ -312,7 +314,7 @@ int main()
   }
   {
     // Really broken: an element's value representation overwritten before the pixel data.
-    std::vector<char> bytes = Bytes(std::string(RGMC_PYDICOM_DIR) + "/CT_small.dcm");
+    std::vector<unsigned char> bytes = Bytes(std::string(RGMC_PYDICOM_DIR) + "/CT_small.dcm");
     const std::string vr = "DA";
     auto at = std::search(bytes.begin() + 132, bytes.end(), vr.begin(), vr.end());
     RGMC_CHECK(at != bytes.end(), "CT_small.dcm has no DA element");

@@ -59,12 +59,12 @@ ThreadsFor(int threads)
 /// Everything one run produced, as bytes.
 struct Result
 {
-  std::vector<char> Bytes;
+  std::vector<unsigned char> Bytes;
   std::int64_t Triangles = 0;
   template <typename T>
   void Add(const T* data, std::size_t n)
   {
-    const char* p = reinterpret_cast<const char*>(data);
+    const auto* p = reinterpret_cast<const unsigned char*>(data);
     this->Bytes.insert(this->Bytes.end(), p, p + n * sizeof(T));
   }
 };

@@ -34,9 +34,9 @@ double SynValue(int i, int j, int k)
 }
 
 template <typename T>
-void Put(std::vector<char>& h, int offset, T value, bool big)
+void Put(std::vector<unsigned char>& h, int offset, T value, bool big)
 {
-  char bytes[sizeof(T)];
+  unsigned char bytes[sizeof(T)];
   std::memcpy(bytes, &value, sizeof(T));
   if (big)
   {
@@ -47,11 +47,11 @@ void Put(std::vector<char>& h, int offset, T value, bool big)
 
 /// A NIfTI-1 file written field by field (big endian), int16 data, slope 0.5, intercept 10, a
 /// rotated qform with qfac -1, no sform; `sizeofHdr`, `magic` and `datatype` make it wrong.
-std::vector<char> SyntheticNIfTI(
+std::vector<unsigned char> SyntheticNIfTI(
   int sizeofHdr = 348, const char* magic = "n+1", short datatype = 4, short dim0 = 3)
 {
   const bool big = true;
-  std::vector<char> h(352, 0);
+  std::vector<unsigned char> h(352, 0);
   Put<std::int32_t>(h, 0, sizeofHdr, big);
   const short dim[8] = { dim0, SynDims[0], SynDims[1], SynDims[2], 1, 1, 1, 1 };
   for (int d = 0; d < 8; ++d)
@@ -91,13 +91,13 @@ std::vector<char> SyntheticNIfTI(
   return h;
 }
 
-void WritePlain(const std::string& path, const std::vector<char>& bytes)
+void WritePlain(const std::string& path, const std::vector<unsigned char>& bytes)
 {
   std::ofstream(path, std::ios::binary)
-    .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
-void WriteGz(const std::string& path, const std::vector<char>& bytes)
+void WriteGz(const std::string& path, const std::vector<unsigned char>& bytes)
 {
   gzFile out = gzopen(path.c_str(), "wb");
   gzwrite(out, bytes.data(), static_cast<unsigned>(bytes.size()));
@@ -230,15 +230,17 @@ void BadFiles(vtkMultiProcessController* controller, const std::string& dir)
     WritePlain(dir + "/analyze.nii", SyntheticNIfTI(348, "\0\0\0"));
     WritePlain(dir + "/complex.nii", SyntheticNIfTI(348, "n+1", 32));
     WritePlain(dir + "/dim0.nii", SyntheticNIfTI(348, "n+1", 4, 0));
-    std::vector<char> good = SyntheticNIfTI();
-    WritePlain(dir + "/short-header.nii", std::vector<char>(good.begin(), good.begin() + 200));
-    WritePlain(dir + "/truncated.nii", std::vector<char>(good.begin(), good.end() - 1000));
+    std::vector<unsigned char> good = SyntheticNIfTI();
+    WritePlain(
+      dir + "/short-header.nii", std::vector<unsigned char>(good.begin(), good.begin() + 200));
+    WritePlain(dir + "/truncated.nii", std::vector<unsigned char>(good.begin(), good.end() - 1000));
     // A gzip stream cut at 60%: the ranks reading the last slices find the end.
     WriteGz(dir + "/full.nii.gz", good);
     std::ifstream in(dir + "/full.nii.gz", std::ios::binary);
-    std::vector<char> z((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    WritePlain(
-      dir + "/truncated.nii.gz", std::vector<char>(z.begin(), z.begin() + z.size() * 6 / 10));
+    std::vector<unsigned char> z(
+      (std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    WritePlain(dir + "/truncated.nii.gz",
+      std::vector<unsigned char>(z.begin(), z.begin() + z.size() * 6 / 10));
   }
   controller->Barrier();
   expect("missing.nii", { "no such file" });

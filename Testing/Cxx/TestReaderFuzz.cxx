@@ -26,20 +26,22 @@ using namespace rgmc_test;
 namespace
 {
 
-std::vector<char> Load(const std::string& path)
+std::vector<unsigned char> Load(const std::string& path)
 {
   std::ifstream in(path, std::ios::binary);
-  return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return std::vector<unsigned char>(
+    (std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-void Save(const std::string& path, const std::vector<char>& bytes)
+void Save(const std::string& path, const std::vector<unsigned char>& bytes)
 {
   std::ofstream(path, std::ios::binary)
-    .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
 /// One mutant of `bytes`: a few random edits, most of them in the first `focus` bytes.
-std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::size_t focus)
+std::vector<unsigned char> Mutate(
+  std::vector<unsigned char> bytes, std::mt19937& random, std::size_t focus)
 {
   auto position = [&]() -> std::size_t
   {
@@ -59,14 +61,12 @@ std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::siz
     {
       case 0: // flip bits
         bytes[position()] ^=
-          static_cast<char>(1 << std::uniform_int_distribution<int>(0, 7)(random));
+          static_cast<unsigned char>(1 << std::uniform_int_distribution<int>(0, 7)(random));
         break;
       case 1: // an interesting byte
       {
-        // Bytes, the same on any platform (char is unsigned on arm64).
         static const unsigned char values[] = { 0x00, 0xff, 0x7f, 0x80, 0x01, 0x20 };
-        bytes[position()] =
-          static_cast<char>(values[std::uniform_int_distribution<int>(0, 5)(random)]);
+        bytes[position()] = values[std::uniform_int_distribution<int>(0, 5)(random)];
         break;
       }
       case 2: // an interesting 32-bit value (lengths, dimensions)
@@ -77,7 +77,7 @@ std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::siz
         const std::size_t at = position();
         for (int b = 0; b < 4 && at + b < bytes.size(); ++b)
         {
-          bytes[at + b] = static_cast<char>(v >> (8 * b));
+          bytes[at + b] = static_cast<unsigned char>(v >> (8 * b));
         }
         break;
       }
@@ -97,7 +97,7 @@ std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::siz
         const std::size_t from = position(), to = position();
         const std::size_t n = std::min<std::size_t>(
           bytes.size() - from, std::uniform_int_distribution<int>(1, 64)(random));
-        std::vector<char> run(bytes.begin() + from, bytes.begin() + from + n);
+        std::vector<unsigned char> run(bytes.begin() + from, bytes.begin() + from + n);
         bytes.insert(bytes.begin() + std::min(to, bytes.size()), run.begin(), run.end());
       }
     }
@@ -105,15 +105,15 @@ std::vector<char> Mutate(std::vector<char> bytes, std::mt19937& random, std::siz
   return bytes;
 }
 
-std::vector<char> Gzip(const std::vector<char>& bytes)
+std::vector<unsigned char> Gzip(const std::vector<unsigned char>& bytes)
 {
   uLongf size = compressBound(static_cast<uLong>(bytes.size())) + 32;
-  std::vector<char> out(size);
+  std::vector<unsigned char> out(size);
   z_stream z{};
   deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  z.next_in = const_cast<Bytef*>(bytes.data());
   z.avail_in = static_cast<uInt>(bytes.size());
-  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.next_out = out.data();
   z.avail_out = static_cast<uInt>(out.size());
   deflate(&z, Z_FINISH);
   out.resize(z.total_out);
@@ -137,7 +137,7 @@ int main(int argc, char* argv[])
   struct Seed
   {
     std::string Name;
-    std::vector<char> Bytes;
+    std::vector<unsigned char> Bytes;
     bool Nifti, Gzip;
   };
   std::vector<Seed> seeds;
@@ -145,7 +145,7 @@ int main(int argc, char* argv[])
   {
     seeds.push_back(Seed{ name, Load(pydicom + "/" + name), false, false });
   }
-  const std::vector<char> nifti =
+  const std::vector<unsigned char> nifti =
     Gunzip(std::string(RGMC_MRICRON_DIR) + "/JHU-WhiteMatter-labels-2mm.nii.gz");
   seeds.push_back(Seed{ "labels.nii", nifti, true, false });
   seeds.push_back(Seed{ "labels.nii.gz", nifti, true, true });
@@ -166,7 +166,7 @@ int main(int argc, char* argv[])
     {
       // A NIfTI mutant of the .nii.gz is mutated before compression (the header and voxels
       // matter; a broken gzip stream is also tried now and then).
-      std::vector<char> bytes = Mutate(seed.Bytes, random, seed.Nifti ? 352 : 2048);
+      std::vector<unsigned char> bytes = Mutate(seed.Bytes, random, seed.Nifti ? 352 : 2048);
       if (seed.Gzip)
       {
         bytes = Gzip(bytes);

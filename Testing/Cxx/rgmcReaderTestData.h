@@ -32,11 +32,11 @@ namespace rgmc_test
 namespace fs = std::filesystem;
 
 /// The bytes of a gzip file (what zlib could decompress of it).
-inline std::vector<char> Gunzip(const std::string& path)
+inline std::vector<unsigned char> Gunzip(const std::string& path)
 {
-  std::vector<char> bytes;
+  std::vector<unsigned char> bytes;
   gzFile in = gzopen(path.c_str(), "rb");
-  char chunk[1 << 16];
+  unsigned char chunk[1 << 16];
   for (int got; (got = gzread(in, chunk, sizeof(chunk))) > 0;)
   {
     bytes.insert(bytes.end(), chunk, chunk + got);
@@ -101,8 +101,9 @@ inline bool WriteNpy(const std::string& path, vtkImageData* image)
   std::ofstream out(path, std::ios::binary);
   out.write("\x93NUMPY\x01\x00", 8);
   const std::uint16_t length = static_cast<std::uint16_t>(header.size());
-  const char le[2] = { static_cast<char>(length & 0xff), static_cast<char>(length >> 8) };
-  out.write(le, 2);
+  const unsigned char le[2] = { static_cast<unsigned char>(length & 0xff),
+    static_cast<unsigned char>(length >> 8) };
+  out.write(reinterpret_cast<const char*>(le), 2);
   out << header;
   out.write(reinterpret_cast<const char*>(hu->GetPointer(0)),
     static_cast<std::streamsize>(hu->GetNumberOfValues() * sizeof(short)));

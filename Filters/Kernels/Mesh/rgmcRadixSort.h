@@ -237,7 +237,7 @@ bool RadixSortPacked(std::size_t n, KeyAt&& keyAt, Put&& put, Parallel&& paralle
   const std::uint64_t largestKey = ~std::uint64_t(0) >> indexBits;
   LargeVector<std::uint64_t> packed(n);
   const std::int64_t ranges = static_cast<std::int64_t>((n + RadixRange - 1) / RadixRange);
-  std::vector<char> fits(static_cast<std::size_t>(ranges), 1);
+  std::vector<std::uint8_t> fits(static_cast<std::size_t>(ranges), 1);
   parallel(ranges,
     [&](std::int64_t r)
     {

@@ -247,7 +247,7 @@ public:
     // pairs of one colour), so blocking sends in that order cannot deadlock, and there are
     // fewer steps than twice the most neighbours a rank has, whatever the number of ranks.
     const int numRanks = static_cast<int>(this->Boxes.size());
-    std::vector<std::vector<char>> used(static_cast<std::size_t>(numRanks));
+    std::vector<std::vector<std::uint8_t>> used(static_cast<std::size_t>(numRanks));
     std::vector<std::pair<int, int>> mineByColour;
     for (int a = 0; a < numRanks; ++a)
     {
