@@ -74,8 +74,9 @@ inline vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
 /// (30 ns a value in Debian's VTK 9.2 against about 1 here: 1.7 s for each of the two scans of a
 /// 384^3 volume). The same values VTK computes: for every component the smallest and largest
 /// value, NaN skipped, and the finite ones; for an array that is not one contiguous block, of no
-/// values, or with a component without one, nothing is stored and VTK computes as before. Call
-/// it once the values are final: VTK drops the ranges when the array is modified.
+/// values, of plain char (whose sign is the platform's), or with a component without a value,
+/// nothing is stored and VTK computes as before. Call it once the values are final: VTK drops
+/// the ranges when the array is modified.
 void CacheRanges(vtkDataArray* array);
 
 } // namespace rgmc

@@ -18,6 +18,7 @@
 #include "vtkPointData.h"
 #include "vtkSMPTools.h"
 #include "vtkShortArray.h"
+#include "vtkSignedCharArray.h"
 #include "vtkSmartPointer.h"
 #include "vtkUnsignedLongLongArray.h"
 
@@ -87,8 +88,11 @@ void CheckValueTypes()
   const vtkIdType many = 700001;
   CheckArray<vtkShortArray>("int16", many, 1, true,
     [](std::mt19937_64& r, vtkIdType) { return static_cast<short>(r() % 5000) - 2000; });
-  CheckArray<vtkCharArray>("char, negative values where char is signed", many, 2, true,
+  // Plain char is left to VTK (its sign is the platform's): nothing stored, VTK's own ranges.
+  CheckArray<vtkCharArray>("char", many, 2, false,
     [](std::mt19937_64& r, vtkIdType) { return static_cast<char>(r() % 256); });
+  CheckArray<vtkSignedCharArray>("signed char", many, 1, true,
+    [](std::mt19937_64& r, vtkIdType) { return static_cast<signed char>(r() % 256 - 128); });
   CheckArray<vtkUnsignedLongLongArray>("uint64 beyond 2^53", 1000, 1, true,
     [](std::mt19937_64& r, vtkIdType)
     { return std::numeric_limits<std::uint64_t>::max() - r() % 7; });
