@@ -283,17 +283,16 @@ int vtkRGVolumeReader::RequestData(
 bool vtkRGVolumeReader::ReadReusing(const int extent[6], vtkDataArray* scalars,
   vtkDataArray* previous, const int previousExtent[6], std::string& message)
 {
-  const bool sameRows = previous && previous->GetDataType() == scalars->GetDataType() &&
-    previous->GetNumberOfComponents() == scalars->GetNumberOfComponents() &&
-    std::equal(extent, extent + 4, previousExtent);
-  const int lo = std::max(extent[4], previousExtent[4]);
-  const int hi = std::min(extent[5], previousExtent[5]);
-  if (!sameRows || lo > hi)
+  int lo, hi;
+  if (!previous || previous->GetDataType() != scalars->GetDataType() ||
+    previous->GetNumberOfComponents() != scalars->GetNumberOfComponents() ||
+    !rgmc::SharedSlices(extent, previousExtent, lo, hi))
   {
     return this->ReadExtent(extent, scalars, message);
   }
-  const std::size_t sliceBytes = static_cast<std::size_t>(extent[1] - extent[0] + 1) *
-    static_cast<std::size_t>(extent[3] - extent[2] + 1) *
+  const vtkIdType slicePoints =
+    vtkIdType(extent[1] - extent[0] + 1) * vtkIdType(extent[3] - extent[2] + 1);
+  const std::size_t sliceBytes = static_cast<std::size_t>(slicePoints) *
     static_cast<std::size_t>(scalars->GetNumberOfComponents() * scalars->GetDataTypeSize());
   auto* to = static_cast<unsigned char*>(scalars->GetVoidPointer(0));
   const auto* from = static_cast<const unsigned char*>(previous->GetVoidPointer(0));
@@ -311,9 +310,7 @@ bool vtkRGVolumeReader::ReadReusing(const int extent[6], vtkDataArray* scalars,
     vtkSmartPointer<vtkDataArray> read;
     read.TakeReference(vtkDataArray::CreateDataArray(scalars->GetDataType()));
     read->SetNumberOfComponents(scalars->GetNumberOfComponents());
-    read->SetNumberOfTuples(static_cast<vtkIdType>(sliceBytes /
-                              (scalars->GetDataTypeSize() * scalars->GetNumberOfComponents())) *
-      (run[1] - run[0] + 1));
+    read->SetNumberOfTuples(slicePoints * (run[1] - run[0] + 1));
     if (!this->ReadExtent(part, read, message))
     {
       return false;

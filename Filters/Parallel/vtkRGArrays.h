@@ -68,6 +68,16 @@ inline vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
   return other;
 }
 
+/// The slices [lo, hi] that a piece of `extent` shares with one of `previous` (the piece a
+/// source made before, asked for again with ghost slices): both must have the same rows and
+/// columns; false when they share none.
+inline bool SharedSlices(const int extent[6], const int previous[6], int& lo, int& hi)
+{
+  lo = std::max(extent[4], previous[4]);
+  hi = std::min(extent[5], previous[5]);
+  return std::equal(extent, extent + 4, previous) && lo <= hi;
+}
+
 /// Stores `array`'s range and finite range, per component, where VTK keeps them once computed
 /// (vtkAbstractArray::PER_COMPONENT and PER_FINITE_COMPONENT), so that GetRange,
 /// GetFiniteRange and ParaView's data information find them instead of scanning the array again

@@ -259,8 +259,9 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
   const vtkIdType slice = vtkIdType(ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1);
   short* out = hu->GetPointer(0);
   // The slices shared with the piece made last, when nothing has changed since, are copied.
+  int lo, hi;
   vtkSmartPointer<vtkShortArray> previous;
-  if (this->LastPiece && this->LastPiece != hu && std::equal(ext, ext + 4, this->LastExtent))
+  if (this->LastPiece && this->LastPiece != hu && rgmc::SharedSlices(ext, this->LastExtent, lo, hi))
   {
     previous = this->LastPiece;
   }
@@ -289,7 +290,7 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
         {
           const int k = first + static_cast<int>(s);
           short* v = out + (k - ext[4]) * slice;
-          if (previous && k >= last[4] && k <= last[5])
+          if (previous && k >= lo && k <= hi)
           {
             const short* from = previous->GetPointer(0) + (k - last[4]) * slice;
             std::copy(from, from + slice, v);
