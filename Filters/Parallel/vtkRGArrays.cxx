@@ -89,11 +89,31 @@ std::vector<Extremes<T>> ComponentExtremes(const T* values, vtkIdType tuples, in
         Extremes<T>* e = partial.data() + c * components;
         const vtkIdType end = std::min(tuples, (c + 1) * Chunk);
         const T* v = values + c * Chunk * components;
-        for (vtkIdType t = c * Chunk; t < end; ++t)
+        if constexpr (std::is_floating_point<T>::value)
         {
+          for (vtkIdType t = c * Chunk; t < end; ++t)
+          {
+            for (int k = 0; k < components; ++k)
+            {
+              e[k].Add(*v++);
+            }
+          }
+        }
+        else
+        {
+          // Integers are all finite: a plain minimum and maximum, which the compiler vectorizes.
+          const vtkIdType n = end - c * Chunk;
           for (int k = 0; k < components; ++k)
           {
-            e[k].Add(*v++);
+            T low = e[k].AllLow, high = e[k].AllHigh;
+            for (vtkIdType t = 0; t < n; ++t)
+            {
+              low = std::min(low, v[t * components + k]);
+              high = std::max(high, v[t * components + k]);
+            }
+            e[k].AllLow = e[k].FiniteLow = low;
+            e[k].AllHigh = e[k].FiniteHigh = high;
+            e[k].AnyValue = e[k].AnyFinite = n > 0;
           }
         }
       }

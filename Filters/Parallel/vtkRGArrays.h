@@ -81,8 +81,8 @@ inline bool SharedSlices(const int extent[6], const int previous[6], int& lo, in
 /// Stores `array`'s range and finite range, per component, where VTK keeps them once computed
 /// (vtkAbstractArray::PER_COMPONENT and PER_FINITE_COMPONENT), so that GetRange,
 /// GetFiniteRange and ParaView's data information find them instead of scanning the array again
-/// (30 ns a value in Debian's VTK 9.2 against about 1 here: 1.7 s for each of the two scans of a
-/// 384^3 volume). The same values VTK computes: for every component the smallest and largest
+/// (about 30 ns a value for each of them in Debian's VTK 9.2: 1.7 s for each of the two scans of
+/// a 384^3 volume). The same values VTK computes: for every component the smallest and largest
 /// value, NaN skipped, and the finite ones; for an array that is not one contiguous block, of no
 /// values, of plain char (whose sign is the platform's), or with a component without a value,
 /// nothing is stored and VTK computes as before. Call it once the values are final: VTK drops

@@ -91,8 +91,11 @@ void CheckValueTypes()
   // Plain char is left to VTK (its sign is the platform's): nothing stored, VTK's own ranges.
   CheckArray<vtkCharArray>("char", many, 2, false,
     [](std::mt19937_64& r, vtkIdType) { return static_cast<char>(r() % 256); });
-  CheckArray<vtkSignedCharArray>("signed char", many, 1, true,
-    [](std::mt19937_64& r, vtkIdType) { return static_cast<signed char>(r() % 256 - 128); });
+  // Each component in a range of its own (-100..-51, -40..9, 20..69), so that mixing them up
+  // shows.
+  CheckArray<vtkSignedCharArray>("signed char, 3 components", many, 3, true,
+    [](std::mt19937_64& r, vtkIdType i)
+    { return static_cast<signed char>(static_cast<int>(r() % 50) + 60 * (i % 3) - 100); });
   CheckArray<vtkUnsignedLongLongArray>("uint64 beyond 2^53", 1000, 1, true,
     [](std::mt19937_64& r, vtkIdType)
     { return std::numeric_limits<std::uint64_t>::max() - r() % 7; });
