@@ -3,6 +3,7 @@
 // infinities, for every value type, on 1, 2, 16 and 64 threads; and present on the outputs of
 // the NIfTI reader (real volumes of Debian's mricron-data) and of the phantom.
 #include "rgmcCheck.h"
+#include "rgmcThreadCompare.h"
 #include "vtkRGArrays.h"
 #include "vtkRGNIfTIReader.h"
 #include "vtkRGPhantomSource.h"
@@ -171,6 +172,7 @@ void CheckNIfTI()
 
 int main()
 {
+  rgmc_test::AllowThreads(64);
   CheckValueTypes();
   CheckPhantom();
   CheckNIfTI();

@@ -88,6 +88,7 @@ bool SameBits(double x, double y)
 
 int main(int argc, char* argv[])
 {
+  rgmc_test::AllowThreads(64);
   vtkSmartPointer<vtkMultiProcessController> controller = rgmc_test::StartController(argc, argv);
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
   vtkNew<vtkDummyController> single;

@@ -38,7 +38,27 @@ inline int& ThreadCount()
   return threads;
 }
 
-/// Takes `--threads N` out of the arguments.
+/// The threads vtkSMPTools runs when asked for `threads` of STDThread.
+inline int ThreadsGiven(int threads)
+{
+  int given = 0;
+  vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+    [&]() { given = vtkSMPTools::GetEstimatedNumberOfThreads(); });
+  return given;
+}
+
+/// Lets vtkSMPTools run up to `threads` threads however many cores this machine has (see
+/// rgmcTestCores.cxx), and checks that it does.
+inline void AllowThreads(int threads)
+{
+  ::setenv("RGMC_TEST_CORES", std::to_string(threads).c_str(), 1);
+  const int given = ThreadsGiven(threads);
+  RGMC_CHECK(given == threads,
+    "vtkSMPTools runs " << given << " threads when asked for " << threads
+                        << " (is rgmcTestCores.cxx linked into the test?)");
+}
+
+/// Takes `--threads N` out of the arguments, and lets vtkSMPTools run N threads.
 inline void ParseThreads(int& argc, char** argv)
 {
   for (int a = 1; a + 1 < argc; ++a)
@@ -46,6 +66,7 @@ inline void ParseThreads(int& argc, char** argv)
     if (std::string(argv[a]) == "--threads")
     {
       ThreadCount() = std::atoi(argv[a + 1]);
+      AllowThreads(ThreadCount());
       for (int b = a; b + 2 <= argc; ++b)
       {
         argv[b] = argv[b + 2];
@@ -177,12 +198,16 @@ inline void UpdateAtThreads(
   {
     between();
   }
+  int given = 0;
   vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
     [&]()
     {
+      given = vtkSMPTools::GetEstimatedNumberOfThreads();
       ModifiedUpstream(algorithm);
       algorithm->Update();
     });
+  RGMC_CHECK(
+    given == threads, what << ": vtkSMPTools ran " << given << " threads, not " << threads);
   const std::string d = Difference(single, algorithm->GetOutputDataObject(0));
   RGMC_CHECK(d.empty(), what << ": " << d << " differ between 1 and " << threads << " threads");
 }
