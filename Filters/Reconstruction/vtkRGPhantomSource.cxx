@@ -2,6 +2,7 @@
 // ramps and deterministic per-voxel noise.
 #include "vtkRGPhantomSource.h"
 
+#include "rgmcPhantomNoise.h"
 #include "vtkRGArrays.h"
 #include "vtkRGParallel.h"
 
@@ -22,8 +23,6 @@ vtkStandardNewMacro(vtkRGPhantomSource);
 
 namespace
 {
-
-constexpr double Pi = 3.14159265358979323846;
 
 double Length3(double x, double y, double z)
 {
@@ -62,30 +61,41 @@ void Mix(double& value, double target, double weight)
   value += weight * (target - value);
 }
 
+// Most shapes are far from most voxels: there their weight is 0 (a Mix of nothing) or their
+// test fails, so they are not evaluated. The boxes below are that, conservatively: a voxel
+// outside one is farther than the ramp plus 1e-6 mm from the shape along one axis, and each
+// shape's signed distance is at least its distance along any one axis (less the shape's
+// reach), so the voxel's value is the same, to the bit, as if the shape had been evaluated.
+constexpr double Margin = 1e-6;
+
+/// Whether |p - c| is within `reach` + ramp along every axis.
+bool Near(const double p[3], const double c[3], const double reach[3], double ramp)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (std::fabs(p[a] - c[a]) > reach[a] + ramp + Margin)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Whether EllipsoidSd(p, c, r) can be at most `ramp`: q >= |p_a - c_a| / r_a on each axis, so
+/// the distance exceeds the ramp beyond r_a (1 + ramp / min r).
+bool NearEllipsoid(const double p[3], const double c[3], const double r[3], double ramp)
+{
+  const double grow = ramp / std::min(r[0], std::min(r[1], r[2]));
+  const double reach[3] = { r[0] * grow + r[0], r[1] * grow + r[1], r[2] * grow + r[2] };
+  return Near(p, c, reach, 0.0);
+}
+
 // The anatomy, in mm. The cranium is a shell between two ellipsoids.
 const double HeadC[3] = { 0, 5, 0 }, HeadR[3] = { 80, 100, 115 };
 const double SkullC[3] = { 0, 0, 25 }, SkullOuter[3] = { 72, 90, 80 },
              SkullInner[3] = { 65, 83, 73 };
 const double VentricleR[3] = { 6, 20, 10 };
 const double EyeR = 12;
-
-std::uint64_t SplitMix(std::uint64_t x)
-{
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-/// A standard normal sample from a voxel's global index (Box-Muller on hashed uniforms).
-double Noise(std::uint64_t index, int seed)
-{
-  const std::uint64_t h1 = SplitMix(index * 2 + (std::uint64_t(std::uint32_t(seed)) << 40));
-  const std::uint64_t h2 = SplitMix(h1 ^ 0xD1B54A32D192ED03ull);
-  const double u1 = (double(h1 >> 11) + 1.0) / 9007199254740993.0; // (0, 1]
-  const double u2 = double(h2 >> 11) / 9007199254740992.0;
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * Pi * u2);
-}
 
 /// Brain and ventricles inside the cranium (`inner`: the distance to its inner surface); eyes
 /// in front of the orbits.
@@ -97,14 +107,20 @@ void AddBrainAndEyes(const double p[3], double inner, double ramp, double& v)
     for (int side = -1; side <= 1; side += 2)
     {
       const double c[3] = { 8.0 * side, 5, 30 };
-      Mix(v, 8.0, Inside(EllipsoidSd(p, c, VentricleR), ramp));
+      if (NearEllipsoid(p, c, VentricleR, ramp))
+      {
+        Mix(v, 8.0, Inside(EllipsoidSd(p, c, VentricleR), ramp));
+      }
     }
   }
   for (int side = -1; side <= 1; side += 2)
   {
     const double c[3] = { 28.0 * side, 80, 20 };
     const double r[3] = { EyeR, EyeR, EyeR };
-    Mix(v, 15.0, Inside(EllipsoidSd(p, c, r), ramp));
+    if (NearEllipsoid(p, c, r, ramp))
+    {
+      Mix(v, 15.0, Inside(EllipsoidSd(p, c, r), ramp));
+    }
   }
 }
 
@@ -133,9 +149,12 @@ void AddCranium(const double p[3], double inner, double ramp, double& v)
 /// Separate bones below the cranium: the mandible, three vertebrae and a small fragment.
 void AddLowerBones(const double p[3], double ramp, double& v)
 {
-  // Mandible: the front half of a torus.
+  // Mandible: the front half of a torus (its distance is at least |p - c| - 47 across and
+  // |p - c| - 7 along z, and at least 15 - y).
+  const double mandible[3] = { 0, 25, -75 }, mandibleReach[3] = { 47, 47, 7 };
+  if (Near(p, mandible, mandibleReach, ramp) && 15.0 - p[1] <= ramp + Margin)
   {
-    const double c[3] = { 0, 25, -75 };
+    const double* c = mandible;
     const double ring = std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]));
     double sd = std::sqrt((ring - 40) * (ring - 40) + (p[2] - c[2]) * (p[2] - c[2])) - 7;
     sd = std::max(sd, 15.0 - p[1]);
@@ -147,7 +166,11 @@ void AddLowerBones(const double p[3], double ramp, double& v)
   // Three vertebrae (discs between them stay soft tissue).
   for (int n = 0; n < 3; ++n)
   {
-    const double c[3] = { 0, -20, -96.0 + 14.0 * n };
+    const double c[3] = { 0, -20, -96.0 + 14.0 * n }, reach[3] = { 14, 14, 4.5 };
+    if (!Near(p, c, reach, ramp))
+    {
+      continue;
+    }
     const double sd = std::max(CylinderSd(p, 2, c, 14), std::fabs(p[2] - c[2]) - 4.5);
     if (sd < ramp)
     {
@@ -157,7 +180,7 @@ void AddLowerBones(const double p[3], double ramp, double& v)
   // A small fragment.
   {
     const double c[3] = { 50, -50, -45 }, r[3] = { 5, 5, 5 };
-    const double sd = EllipsoidSd(p, c, r);
+    const double sd = NearEllipsoid(p, c, r, ramp) ? EllipsoidSd(p, c, r) : ramp;
     if (sd < ramp)
     {
       Mix(v, 1000.0, Inside(sd, ramp));
@@ -298,10 +321,8 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
           }
           for (int j = ext[2]; j <= ext[3]; ++j)
           {
-            for (int i = ext[0]; i <= ext[1]; ++i)
-            {
-              *v++ = this->Sample(origin, spacing, i, j, k, nx, ny);
-            }
+            this->SampleRow(origin, spacing, ext[0], ext[1], j, k, nx, ny, v);
+            v += ext[1] - ext[0] + 1;
           }
         }
       });
@@ -316,17 +337,29 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
 }
 
 //------------------------------------------------------------------------------
-short vtkRGPhantomSource::Sample(const double origin[3], const double spacing[3], int i, int j,
-  int k, std::uint64_t nx, std::uint64_t ny) const
+void vtkRGPhantomSource::SampleRow(const double origin[3], const double spacing[3], int first,
+  int last, int j, int k, std::uint64_t nx, std::uint64_t ny, short* out) const
 {
-  const double p[3] = { origin[0] + i * spacing[0], origin[1] + j * spacing[1],
-    origin[2] + k * spacing[2] };
-  double v = this->Evaluate(p);
-  if (this->NoiseLevel > 0)
+  double p[3] = { 0, origin[1] + j * spacing[1], origin[2] + k * spacing[2] };
+  // Evaluate returns air (-1000) where the head's signed distance exceeds the ramp, that is
+  // where q = |(p - HeadC) / HeadR| > 1 + ramp / min(HeadR). Along the row, q^2 = dx^2 + s: the
+  // voxels with dx^2 > limit^2 - s + 1e-9 are air without evaluating them (the 1e-9 on q^2 is
+  // far above the rounding of these sums, so none of them is a voxel Evaluate would not give
+  // -1000).
+  const double ramp = this->Ramp();
+  const double limit = 1.0 + ramp / std::min(HeadR[0], std::min(HeadR[1], HeadR[2]));
+  const double dy = (p[1] - HeadC[1]) / HeadR[1], dz = (p[2] - HeadC[2]) / HeadR[2];
+  const double room = limit * limit - (dy * dy + dz * dz) + 1e-9;
+  const double half = room > 0 ? HeadR[0] * std::sqrt(room) * (1.0 + 1e-12) : -1.0;
+  const std::uint64_t row = (std::uint64_t(k) * ny + j) * nx;
+  const double level = this->NoiseLevel;
+  for (int i = first; i <= last; ++i)
   {
-    v += this->NoiseLevel * Noise((std::uint64_t(k) * ny + j) * nx + i, this->RandomSeed);
+    p[0] = origin[0] + i * spacing[0];
+    const double value = std::fabs(p[0] - HeadC[0]) > half ? -1000.0 : this->Evaluate(p);
+    *out++ = level > 0 ? rgmc::phantom::NoisyVoxel(value, level, row + i, this->RandomSeed)
+                       : rgmc::phantom::Voxel(value);
   }
-  return static_cast<short>(std::lround(std::max(-1024.0, std::min(3071.0, v))));
 }
 
 //------------------------------------------------------------------------------

@@ -92,9 +92,10 @@ private:
 
   double Spacing() const;
   double Ramp() const;
-  /// The voxel (i, j, k) in HU, noise included, clamped and rounded to int16.
-  short Sample(const double origin[3], const double spacing[3], int i, int j, int k,
-    std::uint64_t nx, std::uint64_t ny) const;
+  /// The voxels first..last of row (j, k) in HU, noise included, clamped and rounded to int16:
+  /// Evaluate and rgmc::phantom::NoisyVoxel's, to the bit.
+  void SampleRow(const double origin[3], const double spacing[3], int first, int last, int j, int k,
+    std::uint64_t nx, std::uint64_t ny, short* out) const;
 
   // The piece made last (the output's own array: the pipeline empties the output before it
   // asks for the next piece), its extent, and when it was made: a piece asked for again with

@@ -1,9 +1,17 @@
-// The phantom asked for a piece and then for the same piece with ghost layers (as ParaView does
-// once RG Marching Cubes needs them) copies the slices it made already: the result must be the
-// piece a fresh phantom makes, for every piece of 1-4 (ParaView's pieces: extents from
-// vtkExtentTranslator, in slabs and in blocks) and on 1 and 16 threads; and after a change (the
-// noise level) nothing old may be copied.
+// The phantom's voxels are a contract (every documented count and fingerprint depends on them):
+// - each voxel is its definition, Evaluate at the voxel's point plus the noise, clamped and
+//   rounded (rgmcPhantomNoise.h), although rows skip the air around the head and Evaluate skips
+//   the shapes far from the voxel; and the rounding is std::lround's;
+// - whole volumes hash to what the phantom made before those shortcuts (2347b34), so a shortcut
+//   inside Evaluate that changed a voxel fails too;
+// - a piece asked for again with ghost layers (as ParaView does once RG Marching Cubes needs
+//   them) copies the slices it made already: the result must be the piece a fresh phantom makes,
+//   for every piece of 1-4 (ParaView's pieces: extents from vtkExtentTranslator, in slabs and in
+//   blocks); and after a change (the noise level) nothing old may be copied.
+// All on 1 and 16 threads.
 #include "rgmcCheck.h"
+#include "rgmcPhantomNoise.h"
+#include "rgmcThreadCompare.h"
 #include "vtkRGPhantomSource.h"
 
 #include "vtkExtentTranslator.h"
@@ -17,6 +25,8 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <string>
 
 namespace
@@ -57,7 +67,109 @@ vtkSmartPointer<vtkRGPhantomSource> NewPhantom(double noise)
   return phantom;
 }
 
+vtkShortArray* Voxels(vtkImageData* image)
+{
+  return vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars());
+}
+
+/// Sum of the voxels (as uint16) times 0x100000001B3^index, modulo 2^64.
+std::uint64_t Hash(vtkShortArray* values)
+{
+  std::uint64_t hash = 0, weight = 1;
+  for (vtkIdType n = 0; n < values->GetNumberOfValues(); ++n)
+  {
+    hash += std::uint64_t(std::uint16_t(values->GetValue(n))) * weight;
+    weight *= 0x100000001B3ull;
+  }
+  return hash;
+}
+
 } // namespace
+
+void CheckRounding()
+{
+  int wrong = 0;
+  auto check = [&](double x)
+  {
+    const long expected = std::lround(std::max(-1024.0, std::min(3071.0, x)));
+    wrong += rgmc::phantom::Voxel(x) != expected ? 1 : 0;
+  };
+  for (int eighth = -1100 * 8; eighth <= 3100 * 8; ++eighth)
+  {
+    const double x = eighth / 8.0;
+    check(x);
+    check(std::nextafter(x, -1e9));
+    check(std::nextafter(x, 1e9));
+  }
+  check(-0.0);
+  check(0.49999999999999994);
+  check(-0.49999999999999994);
+  RGMC_CHECK(wrong == 0, wrong << " values rounded otherwise than std::lround rounds them");
+}
+
+void CheckDefinition(int nx, int ny, int nz, double fieldOfView, double noise, int seed)
+{
+  vtkNew<vtkRGPhantomSource> phantom;
+  phantom->SetDimensions(nx, ny, nz);
+  phantom->SetFieldOfView(fieldOfView);
+  phantom->SetNoiseLevel(noise);
+  phantom->SetRandomSeed(seed);
+  phantom->Update();
+  vtkImageData* image = phantom->GetOutput();
+  vtkShortArray* values = Voxels(image);
+  vtkIdType wrong = 0, air = 0;
+  for (int k = 0; k < nz; ++k)
+  {
+    for (int j = 0; j < ny; ++j)
+    {
+      for (int i = 0; i < nx; ++i)
+      {
+        double p[3];
+        const vtkIdType index = (vtkIdType(k) * ny + j) * nx + i;
+        image->GetPoint(index, p);
+        const double value = phantom->Evaluate(p);
+        air += value == -1000.0 ? 1 : 0;
+        const short expected = noise > 0
+          ? rgmc::phantom::NoisyVoxel(value, noise, std::uint64_t(index), seed)
+          : rgmc::phantom::Voxel(value);
+        wrong += values->GetValue(index) != expected ? 1 : 0;
+      }
+    }
+  }
+  RGMC_CHECK(wrong == 0,
+    wrong << " voxels of the " << nx << " x " << ny << " x " << nz << " phantom (field of view "
+          << fieldOfView << ", noise " << noise << ") differ from their definition");
+  RGMC_CHECK(air > 0 && air < values->GetNumberOfValues(),
+    "the " << nx << " x " << ny << " x " << nz << " phantom should hold air and the head");
+}
+
+void CheckHashes()
+{
+  struct Volume
+  {
+    int Dimensions[3];
+    double Noise;
+    int Seed;
+    std::uint64_t Hash; // made by 2347b34's phantom, a voxel at a time
+  };
+  const Volume volumes[] = { { { 64, 64, 64 }, 12, 1, 0x0b7282f98cdb9590ull },
+    { { 97, 80, 61 }, 12, 7, 0x20dc7914b2a54413ull },
+    { { 50, 50, 50 }, 1000, 3, 0x651925c37ffb8013ull },
+    { { 64, 64, 64 }, 0, 1, 0xacc586e22e7453e5ull },
+    { { 200, 180, 40 }, 12, -5, 0x62296b750f39e3c3ull } };
+  for (const Volume& volume : volumes)
+  {
+    vtkNew<vtkRGPhantomSource> phantom;
+    phantom->SetDimensions(volume.Dimensions[0], volume.Dimensions[1], volume.Dimensions[2]);
+    phantom->SetNoiseLevel(volume.Noise);
+    phantom->SetRandomSeed(volume.Seed);
+    phantom->Update();
+    RGMC_CHECK(Hash(Voxels(phantom->GetOutput())) == volume.Hash,
+      "the " << volume.Dimensions[0] << " x " << volume.Dimensions[1] << " x "
+             << volume.Dimensions[2] << " phantom (noise " << volume.Noise << ", seed "
+             << volume.Seed << ") is not the one made before");
+  }
+}
 
 void CheckPieces(int mode)
 {
@@ -83,11 +195,17 @@ void CheckPieces(int mode)
 
 int main()
 {
+  rgmc_test::AllowThreads(64);
+  CheckRounding();
   for (int threads : { 1, 16 })
   {
     vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
       [&]()
       {
+        CheckDefinition(160, 30, 200, 240, 12, 3);
+        CheckDefinition(40, 70, 33, 170, 0, 1);
+        CheckDefinition(33, 31, 90, 300, 1000, -2);
+        CheckHashes();
         CheckPieces(vtkExtentTranslator::Z_SLAB_MODE);
         CheckPieces(vtkExtentTranslator::BLOCK_MODE);
       });
