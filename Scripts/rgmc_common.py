@@ -119,6 +119,45 @@ def mpiexec_command(ranks, mpiexec=None):
     return command
 
 
+def cores_per_rank(ranks):
+    """The cores this process may run on, shared among the ranks on this node: under an mpiexec
+    that binds each rank to a core, 1; run alone, or relaunched unbound, the node's cores over
+    its ranks."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    local = os.environ.get("OMPI_COMM_WORLD_LOCAL_SIZE") or os.environ.get("MPI_LOCALNRANKS")
+    try:
+        ranks = int(local) if local else ranks
+    except ValueError:
+        pass
+    return max(1, cores // max(1, ranks))
+
+
+def use_threads(requested, ranks):
+    """Runs VTK's (and the plugin's) threaded filters on `requested` threads per rank; None:
+    the cores this rank has (cores_per_rank), unless VTK_SMP_BACKEND_IN_USE or
+    VTK_SMP_MAX_THREADS is set, which VTK then follows as it is. Debian's VTK defaults to its
+    Sequential backend (one thread): STDThread is taken instead when more are asked for.
+    Returns the threads the filters will use. The surface is the same to the bit on any."""
+    from vtkmodules.vtkCommonCore import vtkSMPTools
+    if requested is None:
+        if "VTK_SMP_BACKEND_IN_USE" in os.environ or "VTK_SMP_MAX_THREADS" in os.environ:
+            return vtkSMPTools.GetEstimatedNumberOfThreads()
+        requested = cores_per_rank(ranks)
+    if requested > 1 and vtkSMPTools.GetBackend() == "Sequential":
+        if not vtkSMPTools.SetBackend("STDThread"):
+            print("note: this VTK has no threaded backend: running on 1 thread", file=sys.stderr)
+            return 1
+    vtkSMPTools.Initialize(requested)
+    given = vtkSMPTools.GetEstimatedNumberOfThreads()
+    if given < requested:
+        print("note: VTK runs at most %d threads a process here (its cores), not %d" % (
+            given, requested), file=sys.stderr)
+    return given
+
+
 def mpi_environment():
     # A pvbatch started without mpiexec is an MPI singleton; its launcher variables would
     # confuse the mpiexec started from it.
@@ -130,12 +169,17 @@ def mpi_environment():
     return env
 
 
-def relaunch(script, argv, ranks, render):
-    """Runs `script argv` again with pvbatch on `ranks` MPI ranks; returns its exit code."""
+def relaunch(script, argv, ranks, render, threads=1):
+    """Runs `script argv` again with pvbatch on `ranks` MPI ranks; returns its exit code. With
+    more than one thread a rank, the ranks are not bound to one core each (Open MPI binds them
+    to cores by default)."""
     pvbatch = shutil.which("pvbatch")
     if not pvbatch:
         raise UsageError("cannot find pvbatch on PATH")
-    command = mpiexec_command(ranks) + [pvbatch, "--mpi"]
+    command = mpiexec_command(ranks)
+    if threads > 1 and "--map-by" in command:  # Open MPI
+        command += ["--bind-to", "none"]
+    command += [pvbatch, "--mpi"]
     if render:
         # Under MPI, pvbatch renders off screen (it hangs otherwise); it still needs an X server.
         command.append("--force-offscreen-rendering")

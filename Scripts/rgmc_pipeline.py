@@ -102,6 +102,10 @@ def parse_args(argv):
     parser.add_argument("--ranks", type=int, default=1,
                         help="number of MPI ranks (default 1); the command re-runs itself "
                         "under mpiexec when it is not already running on that many")
+    parser.add_argument("--threads", type=int,
+                        help="threads per rank (default: this machine's cores over the ranks, "
+                        "unless VTK_SMP_BACKEND_IN_USE or VTK_SMP_MAX_THREADS is set; at most "
+                        "its cores); the surface is the same on any")
     parser.add_argument("--plugin", help="the plugin library (default: found in $RGMC_BUILD_DIR or build/)")
     parser.add_argument("--connect", metavar="HOST:PORT",
                         help="run on a pvserver (e.g. mpiexec -n 8 pvserver on a cluster) instead "
@@ -117,6 +121,11 @@ def parse_args(argv):
         parser.error("--ranks must be at least 1")
     if args.connect and args.ranks != 1:
         parser.error("--ranks is for pvbatch here; with --connect the server's ranks are used")
+    if args.threads is not None and args.threads < 1:
+        parser.error("--threads must be at least 1")
+    if args.connect and args.threads is not None:
+        parser.error("--threads is for pvbatch here; a pvserver's threads are set where it "
+                     "starts (VTK_SMP_BACKEND_IN_USE, VTK_SMP_MAX_THREADS)")
     if args.beside_contour and not args.screenshot:
         parser.error("--beside-contour needs --screenshot")
     if args.iterations < 0:
@@ -417,12 +426,15 @@ def main(argv):
     if args.connect:
         rgmc_common.connect(args.connect)
     ranks = rgmc_common.number_of_ranks()
+    threads = None
     if not args.connect:
         if args.ranks > 1 and ranks == 1:
-            return rgmc_common.relaunch(os.path.abspath(__file__), argv, args.ranks,
-                                        render=bool(args.screenshot))
+            return rgmc_common.relaunch(
+                os.path.abspath(__file__), argv, args.ranks, render=bool(args.screenshot),
+                threads=args.threads or rgmc_common.cores_per_rank(args.ranks))
         if ranks != args.ranks:
             print("note: running on %d MPI ranks (--ranks %d)" % (ranks, args.ranks))
+        threads = rgmc_common.use_threads(args.threads, ranks)
 
     from paraview import simple
     from vtkmodules.vtkCommonCore import vtkLogger
@@ -472,7 +484,8 @@ def main(argv):
     report = {
         "input": args.input, "dimensions": dims, "array": array, "array_range": list(value_range),
         "isovalue": args.isovalue, "mode": args.mode, "seeds": args.seed,
-        "seed_search_radius": args.radius, "ranks": ranks, "triangles": triangles,
+        "seed_search_radius": args.radius, "ranks": ranks, "threads": threads,
+        "triangles": triangles,
         "read_seconds": round(read_seconds, 4),
         "extract_seconds": round(extract_seconds, 4), "total_seconds": round(total_seconds, 4),
         "outputs": [],
@@ -484,7 +497,8 @@ def main(argv):
         print("read:       %s" % summary)
         report["reader"] = summary
     print("isovalue:   %g   mode: %s   ranks: %d%s" % (
-        args.isovalue, args.mode, ranks, " (pvserver at %s)" % args.connect if args.connect else ""))
+        args.isovalue, args.mode, ranks,
+        " (pvserver at %s)" % args.connect if args.connect else "   threads: %d a rank" % threads))
     for seed in args.seed:
         print("seed:       (%g, %g, %g)" % tuple(seed))
     print("surface:    %d triangles" % triangles)

@@ -156,6 +156,28 @@ def main():
         check(decimated[1][key] == decimated[3][key], "1 and 3 ranks: the same %s (%s, %s)" % (
             key, decimated[1][key], decimated[3][key]))
 
+    # Threads: by default each rank takes its share of the machine's cores (with VTK_SMP_*
+    # unset: Debian's VTK would run one thread), --threads N sets them (VTK runs at most as
+    # many as the machine has cores); the files are the same to the byte on any.
+    env = {k: v for k, v in os.environ.items() if not k.startswith("VTK_SMP_")}
+    cores = len(os.sched_getaffinity(0))
+    for threads, ranks, expected in ((None, 1, cores), (None, 2, max(1, cores // 2)),
+                                     (3, 1, min(3, cores)), (2, 3, min(2, cores))):
+        out = "%s-threads-%s-%d" % (prefix, threads, ranks)
+        result = run(pipeline + ["--input", volume, "--isovalue", "400", "--seed", "0,0,105",
+                                 "--output", out, "--ranks", str(ranks), "--decimate", "0.9",
+                                 "--formats", "stl,ply"] +
+                     (["--threads", str(threads)] if threads else []), env=env)
+        what = "%d ranks, --threads %s" % (ranks, threads)
+        check(result.returncode == 0, "%s: the pipeline succeeds" % what)
+        report = json.load(open(out + ".json"))
+        check(report["threads"] == expected and "threads: %d a rank" % expected in result.stdout,
+              "%s: %s threads a rank, expected %d" % (what, report["threads"], expected))
+        for extension in ("stl", "ply"):
+            check(open("%s-decimated-1.%s" % (prefix, extension), "rb").read() ==
+                  open("%s.%s" % (out, extension), "rb").read(),
+                  "%s: the decimated %s is the one of 1 rank" % (what, extension.upper()))
+
     # A disk that fills up while writing over the earlier files (the case: a small
     # tmpfs, in a mount namespace of its own, so nothing outlives the test): a non-zero exit that
     # names the file and the cause, the earlier files byte for byte, nothing left beside them;
@@ -197,6 +219,8 @@ def main():
         (["--input", volume, "--isovalue", "400"], "needs at least one --seed"),
         (["--input", volume, "--isovalue", "400", "--seed", "1,2"], "x,y,z"),
         (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--array", "nope"], "no point array"),
+        (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--threads", "0"],
+         "--threads must be at least 1"),
         (["--input", volume, "--isovalue", "9000", "--seed", "0,0,105"], "outside the data range"),
         (["--input", volume, "--isovalue", "400", "--seed", "0,0,900"], "lies outside the volume"),
         (["--input", volume, "--isovalue", "400", "--seed", "0,0,105", "--decimate", "1"],
