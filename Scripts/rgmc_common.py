@@ -169,10 +169,10 @@ def mpi_environment():
     return env
 
 
-def relaunch(script, argv, ranks, render, threads=1):
-    """Runs `script argv` again with pvbatch on `ranks` MPI ranks; returns its exit code. With
-    more than one thread a rank, the ranks are not bound to one core each (Open MPI binds them
-    to cores by default)."""
+def relaunch(script, argv, ranks, render, threads=1, env=None):
+    """Runs `script argv` again with pvbatch on `ranks` MPI ranks, with `env` added to the
+    environment; returns its exit code. With more than one thread a rank, the ranks are not
+    bound to one core each (Open MPI binds them to cores by default)."""
     pvbatch = shutil.which("pvbatch")
     if not pvbatch:
         raise UsageError("cannot find pvbatch on PATH")
@@ -185,7 +185,9 @@ def relaunch(script, argv, ranks, render, threads=1):
         command.append("--force-offscreen-rendering")
     command += [script] + list(argv)
     sys.stdout.flush()
-    return subprocess.call(command, env=mpi_environment())
+    environment = mpi_environment()
+    environment.update(env or {})
+    return subprocess.call(command, env=environment)
 
 
 def is_dicom_file(path):

@@ -391,11 +391,17 @@ def picture(volume, array, final, args, ranks, report):
 class Stages:
     """The job's wall time in consecutive stages (each from the end of the one before), so that
     they add up to the whole; the first, start-up, is the process's age when the script began
-    (pvbatch's own start and MPI's)."""
+    (pvbatch's own start and MPI's), or, when the command started mpiexec itself, the time since
+    the first process started (RGMC_JOB_STARTED, which it passes on)."""
 
     def __init__(self):
         self.last = time.time()
-        self.seconds = {"start-up": process_age()}
+        started = process_age()
+        try:
+            started = max(started, self.last - float(os.environ.get("RGMC_JOB_STARTED", "")))
+        except ValueError:
+            pass
+        self.seconds = {"start-up": started}
 
     def mark(self, name):
         now = time.time()
@@ -431,7 +437,8 @@ def main(argv):
         if args.ranks > 1 and ranks == 1:
             return rgmc_common.relaunch(
                 os.path.abspath(__file__), argv, args.ranks, render=bool(args.screenshot),
-                threads=args.threads or rgmc_common.cores_per_rank(args.ranks))
+                threads=args.threads or rgmc_common.cores_per_rank(args.ranks),
+                env={"RGMC_JOB_STARTED": repr(time.time() - process_age())})
         if ranks != args.ranks:
             print("note: running on %d MPI ranks (--ranks %d)" % (ranks, args.ranks))
         threads = rgmc_common.use_threads(args.threads, ranks)
