@@ -147,7 +147,7 @@ def use_threads(requested, ranks):
             return vtkSMPTools.GetEstimatedNumberOfThreads()
         requested = cores_per_rank(ranks)
     if requested > 1 and vtkSMPTools.GetBackend() == "Sequential":
-        if not vtkSMPTools.SetBackend("STDThread"):
+        if not hasattr(vtkSMPTools, "SetBackend") or not vtkSMPTools.SetBackend("STDThread"):
             print("note: this VTK has no threaded backend: running on 1 thread", file=sys.stderr)
             return 1
     vtkSMPTools.Initialize(requested)
