@@ -101,9 +101,10 @@ def number_of_ranks():
     return servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
 
 
-def mpiexec_command(ranks, mpiexec=None):
+def mpiexec_command(ranks, mpiexec=None, unbound=False):
     """mpiexec (the one on PATH unless given) with the flags this MPI needs to run `ranks`
-    processes on this machine."""
+    processes on this machine; `unbound`: each free to use every core (for threads within a
+    rank; Open MPI binds each rank to one core by default, MPICH does not bind)."""
     mpiexec = mpiexec or shutil.which("mpiexec")
     if not mpiexec:
         raise UsageError("--ranks %d needs mpiexec (Debian: apt-get install openmpi-bin)" % ranks)
@@ -116,6 +117,8 @@ def mpiexec_command(ranks, mpiexec=None):
         # More ranks than cores is fine for testing. Open MPI 5 removed --oversubscribe; this
         # spelling works on 4 and 5.
         command += ["--map-by", ":OVERSUBSCRIBE"]
+        if unbound:
+            command += ["--bind-to", "none"]
     return command
 
 
@@ -176,10 +179,7 @@ def relaunch(script, argv, ranks, render, threads=1, env=None):
     pvbatch = shutil.which("pvbatch")
     if not pvbatch:
         raise UsageError("cannot find pvbatch on PATH")
-    command = mpiexec_command(ranks)
-    if threads > 1 and "--map-by" in command:  # Open MPI
-        command += ["--bind-to", "none"]
-    command += [pvbatch, "--mpi"]
+    command = mpiexec_command(ranks, unbound=threads > 1) + [pvbatch, "--mpi"]
     if render:
         # Under MPI, pvbatch renders off screen (it hangs otherwise); it still needs an X server.
         command.append("--force-offscreen-rendering")

@@ -629,9 +629,7 @@ def run_decimate(args):
     rows = []
     for ranks in (1, 2):
         # Threads need cores: Open MPI binds a rank to one core when it has few ranks.
-        command = rgmc_common.mpiexec_command(ranks)
-        if "--map-by" in command:
-            command += ["--bind-to", "none"]
+        command = rgmc_common.mpiexec_command(ranks, unbound=True)
         command += [args.decimate_binary, "--size", str(args.decimate_size), "--reduction",
                     str(args.decimate_reduction), "--threads", "1,2" if ranks == 1 else "1",
                     "--repeats", str(args.decimate_repeats), "--vtk", "1" if ranks == 1 else "0"]
