@@ -69,6 +69,32 @@ void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
 }
 
 /// The kernels' parallel(count, task) (rgmc::RadixSort's, for one): task(i) for every i in
+/// before[c]: how many of the indices i < c * chunk, 0 <= i < n, have counted(i) true (a
+/// count per chunk on threads, then their sums in order); before has one entry per chunk and
+/// one more, the total.
+template <typename Counted>
+std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& counted)
+{
+  const vtkIdType chunks = (n + chunk - 1) / chunk;
+  std::vector<std::size_t> before(static_cast<std::size_t>(chunks) + 1, 0);
+  rgmc::ParallelFor(chunks, 1,
+    [&](vtkIdType from, vtkIdType to)
+    {
+      for (vtkIdType c = from; c < to; ++c)
+      {
+        for (vtkIdType i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+        {
+          before[static_cast<std::size_t>(c) + 1] += counted(i);
+        }
+      }
+    });
+  for (std::size_t c = 0; c + 1 < before.size(); ++c)
+  {
+    before[c + 1] += before[c];
+  }
+  return before;
+}
+
 /// [0, count), one index a task, on vtkSMPTools' threads through ParallelFor.
 struct Tasks
 {

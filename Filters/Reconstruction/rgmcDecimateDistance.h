@@ -20,6 +20,7 @@
 #include "vtkRGParallel.h"
 #include "vtkRGSpan.h"
 
+#include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
 #include "vtkCommunicator.h"
@@ -33,6 +34,7 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -55,6 +57,10 @@ struct DistanceSurface
   double Hi[3] = { -std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
     -std::numeric_limits<double>::max() };
 
+  /// Chunks of points or cells a task (fixed: the order of the result never depends on the
+  /// threads).
+  static constexpr vtkIdType Chunk = 65536;
+
   explicit DistanceSurface(vtkPolyData* pd)
   {
     vtkPoints* points = pd->GetPoints();
@@ -63,40 +69,113 @@ struct DistanceSurface
     {
       return;
     }
+    this->ReadPoints(pd, points);
+    vtkDataArray* offsets = polys->GetOffsetsArray();
+    vtkDataArray* connectivity = polys->GetConnectivityArray();
+    auto* o32 = vtkAOSDataArrayTemplate<vtkTypeInt32>::FastDownCast(offsets);
+    auto* c32 = vtkAOSDataArrayTemplate<vtkTypeInt32>::FastDownCast(connectivity);
+    auto* o64 = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(offsets);
+    auto* c64 = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(connectivity);
+    const vtkIdType cells = polys->GetNumberOfCells();
+    if (o32 && c32)
+    {
+      this->ReadTriangles(points, cells, o32->GetPointer(0), c32->GetPointer(0));
+    }
+    else if (o64 && c64)
+    {
+      this->ReadTriangles(points, cells, o64->GetPointer(0), c64->GetPointer(0));
+    }
+    else // another storage: a copy of the offsets and connectivity first
+    {
+      std::vector<vtkIdType> first(1, 0), ids;
+      auto it = vtk::TakeSmartPointer(polys->NewIterator());
+      for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+      {
+        vtkIdType n;
+        const vtkIdType* cell;
+        it->GetCurrentCell(n, cell);
+        ids.insert(ids.end(), cell, cell + n);
+        first.push_back(static_cast<vtkIdType>(ids.size()));
+      }
+      this->ReadTriangles(points, cells, first.data(), ids.data());
+    }
+  }
+
+private:
+  /// The points that are not Seam Repair's duplicate copies, in order (chunks on threads).
+  void ReadPoints(vtkPolyData* pd, vtkPoints* points)
+  {
     auto* ghosts = vtkUnsignedCharArray::SafeDownCast(
       pd->GetPointData()->GetArray(vtkDataSetAttributes::GhostArrayName()));
-    double x[3];
-    for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i)
+    const unsigned char* ghost = ghosts ? ghosts->GetPointer(0) : nullptr;
+    auto kept = [ghost](vtkIdType i)
+    { return !ghost || !(ghost[i] & vtkDataSetAttributes::DUPLICATEPOINT); };
+    const vtkIdType n = points->GetNumberOfPoints();
+    const vtkIdType chunks = (n + Chunk - 1) / Chunk;
+    const std::vector<std::size_t> first = CountBefore(n, Chunk, kept);
+    this->Points.resize(3 * first.back());
+    ParallelFor(chunks, 1,
+      [&](vtkIdType from, vtkIdType to)
+      {
+        for (vtkIdType c = from; c < to; ++c)
+        {
+          double* out = this->Points.data() + 3 * first[static_cast<std::size_t>(c)];
+          for (vtkIdType i = c * Chunk; i < std::min(n, (c + 1) * Chunk); ++i)
+          {
+            if (kept(i))
+            {
+              points->GetPoint(i, out);
+              out += 3;
+            }
+          }
+        }
+      });
+  }
+
+  /// The cells of 3 points as canonical triangles, in order, and their box (chunks on threads).
+  template <typename Offset, typename Id>
+  void ReadTriangles(vtkPoints* points, vtkIdType cells, const Offset* offsets, const Id* ids)
+  {
+    const vtkIdType chunks = (cells + Chunk - 1) / Chunk;
+    std::vector<std::array<double, 6>> boxes(static_cast<std::size_t>(chunks));
+    auto isTriangle = [offsets](vtkIdType c) { return offsets[c + 1] - offsets[c] == 3; };
+    const std::vector<std::size_t> first = CountBefore(cells, Chunk, isTriangle);
+    this->Triangles.resize(9 * first.back());
+    ParallelFor(chunks, 1,
+      [&](vtkIdType from, vtkIdType to)
+      {
+        for (vtkIdType c = from; c < to; ++c)
+        {
+          std::array<double, 6>& box = boxes[static_cast<std::size_t>(c)];
+          std::copy(this->Lo, this->Lo + 3, box.begin());
+          std::copy(this->Hi, this->Hi + 3, box.begin() + 3);
+          double* t = this->Triangles.data() + 9 * first[static_cast<std::size_t>(c)];
+          for (vtkIdType i = c * Chunk; i < std::min(cells, (c + 1) * Chunk); ++i)
+          {
+            if (!isTriangle(i))
+            {
+              continue;
+            }
+            for (int k = 0; k < 3; ++k)
+            {
+              points->GetPoint(static_cast<vtkIdType>(ids[offsets[i] + k]), t + 3 * k);
+            }
+            CanonicalTriangle(t);
+            for (int k = 0; k < 9; ++k)
+            {
+              box[k % 3] = std::min(box[k % 3], t[k]);
+              box[3 + k % 3] = std::max(box[3 + k % 3], t[k]);
+            }
+            t += 9;
+          }
+        }
+      });
+    for (const auto& box : boxes)
     {
-      if (ghosts && (ghosts->GetValue(i) & vtkDataSetAttributes::DUPLICATEPOINT))
+      for (int a = 0; a < 3; ++a)
       {
-        continue;
-      }
-      points->GetPoint(i, x);
-      this->Points.insert(this->Points.end(), x, x + 3);
-    }
-    this->Triangles.reserve(9 * static_cast<std::size_t>(polys->GetNumberOfCells()));
-    auto it = vtk::TakeSmartPointer(polys->NewIterator());
-    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
-    {
-      vtkIdType n;
-      const vtkIdType* ids;
-      it->GetCurrentCell(n, ids);
-      if (n != 3)
-      {
-        continue;
-      }
-      double t[9];
-      for (int k = 0; k < 3; ++k)
-      {
-        points->GetPoint(ids[k], t + 3 * k);
-      }
-      CanonicalTriangle(t);
-      this->Triangles.insert(this->Triangles.end(), t, t + 9);
-      for (int k = 0; k < 9; ++k)
-      {
-        this->Lo[k % 3] = std::min(this->Lo[k % 3], t[k]);
-        this->Hi[k % 3] = std::max(this->Hi[k % 3], t[k]);
+        this->Lo[a] = std::min(this->Lo[a], box[a]);
+        this->Hi[a] = std::max(this->Hi[a], box[3 + a]);
       }
     }
   }
@@ -170,7 +249,7 @@ inline std::vector<double> MeasureWithin(const std::vector<double>& points,
   const std::vector<double>& triangles, double bucket, double limit, DirectedDistance& into)
 {
   SpanMark("distance: buckets");
-  const TriangleBuckets buckets(triangles, bucket);
+  const TriangleBuckets buckets(triangles, bucket, Tasks());
   SpanMark("distance: nearest triangles");
   const std::size_t n = points.size() / 3;
   const vtkIdType grain = 4096;

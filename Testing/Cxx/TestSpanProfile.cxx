@@ -196,6 +196,50 @@ void TestSortAndThreads()
     });
 }
 
+/// CountBefore: chunk c's entry is the serial count of the indices before c * chunk, the last
+/// the total, the same on 1, 2, 16 and 64 threads and while recording (chunks that end early,
+/// a count that is not a multiple of the chunk, an empty range).
+void TestCountBefore()
+{
+  std::mt19937_64 random(11);
+  std::vector<std::uint8_t> flags(100003);
+  for (auto& f : flags)
+  {
+    f = random() % 3 == 0;
+  }
+  auto counted = [&flags](vtkIdType i) { return flags[static_cast<std::size_t>(i)] != 0; };
+  const vtkIdType n = static_cast<vtkIdType>(flags.size()), chunk = 4096;
+  for (int threads : { 1, 2, 16, 64 })
+  {
+    vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+      [&]()
+      {
+        const std::vector<std::size_t> before = rgmc::CountBefore(n, chunk, counted);
+        RGMC_CHECK(before.size() == static_cast<std::size_t>((n + chunk - 1) / chunk) + 1,
+          before.size() << " entries on " << threads << " threads");
+        bool same = true;
+        for (std::size_t c = 0; same && c < before.size(); ++c)
+        {
+          std::size_t serial = 0;
+          for (vtkIdType i = 0; i < std::min(n, static_cast<vtkIdType>(c) * chunk); ++i)
+          {
+            serial += flags[static_cast<std::size_t>(i)];
+          }
+          same = before[c] == serial;
+        }
+        RGMC_CHECK(same, "CountBefore equals the serial counts on " << threads << " threads");
+      });
+  }
+  rgmc::SpanRecorder recorder;
+  recorder.Start();
+  const std::vector<std::size_t> recorded = rgmc::CountBefore(n, chunk, counted);
+  recorder.Stop();
+  RGMC_CHECK(recorded.back() == static_cast<std::size_t>(std::count(flags.begin(), flags.end(), 1)),
+    "CountBefore while recording: the total");
+  const std::vector<std::size_t> none = rgmc::CountBefore(0, chunk, counted);
+  RGMC_CHECK(none.size() == 1 && none[0] == 0, "no indices: one entry, 0");
+}
+
 } // namespace
 
 int main()
@@ -203,5 +247,6 @@ int main()
   TestAccounting();
   TestPrefixAndExceptions();
   TestSortAndThreads();
+  TestCountBefore();
   return rgmc_test::Result("TestSpanProfile");
 }

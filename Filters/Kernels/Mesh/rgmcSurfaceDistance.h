@@ -8,9 +8,12 @@
 #ifndef rgmcSurfaceDistance_h
 #define rgmcSurfaceDistance_h
 
+#include "rgmcBuffer.h"
 #include "rgmcKeyMap.h"
+#include "rgmcRadixSort.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -121,17 +124,19 @@ inline void CanonicalTriangle(double t[9])
 }
 
 /// Triangles (9 coordinates each, canonical) in a grid of cubic buckets: each triangle is in
-/// every bucket its bounding box overlaps.
+/// every bucket its bounding box overlaps. Built on tasks (`parallel`, as the radix sort's):
+/// the (bucket, triangle) pairs of fixed chunks of triangles, sorted by bucket; a bucket's
+/// triangles are in increasing order whatever the threads (not that a search would care: the
+/// smallest distance is the same in any order).
 class TriangleBuckets
 {
 public:
   /// `corners`: 9 coordinates a triangle, kept by reference; `size`: the buckets' edge.
-  TriangleBuckets(const std::vector<double>& corners, double size)
+  template <typename Parallel = SerialTasks>
+  TriangleBuckets(const std::vector<double>& corners, double size, Parallel&& parallel = Parallel())
     : Corners(corners)
-    , Index(corners.size() / 9)
   {
-    const std::size_t n = corners.size() / 9;
-    this->Build(n, size);
+    this->Build(corners.size() / 9, size, parallel);
   }
 
   /// The smallest squared distance from p to a triangle, searching the buckets within `limit`
@@ -165,30 +170,104 @@ public:
   }
 
 private:
+  /// Triangles a task of the build (fixed: the chunks never depend on the threads).
+  static constexpr std::size_t Chunk = 16384;
+
   int Cell(double x, int a) const
   {
     const double c = std::floor((x - this->Origin[a]) / this->Size);
     return static_cast<int>(std::max(0.0, std::min<double>(c, this->Dims[a] - 1)));
   }
 
-  void Build(std::size_t n, double size)
+  template <typename Parallel>
+  void Build(std::size_t n, double size, Parallel& parallel)
   {
     if (n == 0)
     {
       return;
     }
-    double lo[3], hi[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      lo[a] = std::numeric_limits<double>::infinity();
-      hi[a] = -lo[a];
-    }
-    for (std::size_t t = 0; t < n; ++t)
-    {
-      for (int k = 0; k < 9; ++k)
+    const std::size_t chunks = (n + Chunk - 1) / Chunk;
+    this->Place(n, chunks, size, parallel);
+    // The pairs of each chunk after those of the chunks before it.
+    std::vector<std::size_t> first(chunks + 1, 0);
+    parallel(static_cast<std::int64_t>(chunks),
+      [&](std::int64_t c)
       {
-        lo[k % 3] = std::min(lo[k % 3], this->Corners[9 * t + k]);
-        hi[k % 3] = std::max(hi[k % 3], this->Corners[9 * t + k]);
+        std::size_t count = 0;
+        this->ForBuckets(
+          static_cast<std::size_t>(c), [&count](std::int64_t, std::size_t) { ++count; });
+        first[static_cast<std::size_t>(c) + 1] = count;
+      });
+    for (std::size_t c = 0; c < chunks; ++c)
+    {
+      first[c + 1] += first[c];
+    }
+    // A pair as one word (the bucket's key above the triangle's bits) where it fits, else as
+    // two; sorted by key, stably, so each bucket's triangles stay in increasing order.
+    int triangleBits = 1, keyBits = 1;
+    while ((std::uint64_t(1) << triangleBits) < n)
+    {
+      ++triangleBits;
+    }
+    const std::uint64_t lastKey = static_cast<std::uint64_t>(
+      this->Key(this->Dims[0] - 1, this->Dims[1] - 1, this->Dims[2] - 1));
+    while (keyBits < 64 && (lastKey >> keyBits) != 0)
+    {
+      ++keyBits;
+    }
+    if (keyBits + triangleBits <= 64)
+    {
+      LargeVector<std::uint64_t> words(first.back());
+      this->Pairs(first, parallel,
+        [&](std::size_t at, std::int64_t key, std::size_t t)
+        { words[at] = static_cast<std::uint64_t>(key) << triangleBits | t; });
+      RadixSort(
+        words, [triangleBits](std::uint64_t w) { return w >> triangleBits; }, parallel);
+      const std::uint64_t mask = (std::uint64_t(1) << triangleBits) - 1;
+      this->Group(
+        words.size(), parallel,
+        [&](std::size_t i) { return static_cast<std::int64_t>(words[i] >> triangleBits); },
+        [&](std::size_t i) { return static_cast<std::uint32_t>(words[i] & mask); });
+      return;
+    }
+    LargeVector<std::pair<std::uint64_t, std::uint32_t>> pairs(first.back());
+    this->Pairs(first, parallel,
+      [&](std::size_t at, std::int64_t key, std::size_t t) {
+        pairs[at] = { static_cast<std::uint64_t>(key), static_cast<std::uint32_t>(t) };
+      });
+    RadixSort(
+      pairs, [](const std::pair<std::uint64_t, std::uint32_t>& p) { return p.first; }, parallel);
+    this->Group(
+      pairs.size(), parallel,
+      [&](std::size_t i) { return static_cast<std::int64_t>(pairs[i].first); },
+      [&](std::size_t i) { return pairs[i].second; });
+  }
+
+  /// The grid: the triangles' box (chunk by chunk, then in chunk order: exact either way), and
+  /// buckets of edge `size` over it.
+  template <typename Parallel>
+  void Place(std::size_t n, std::size_t chunks, double size, Parallel& parallel)
+  {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<std::array<double, 6>> boxes(chunks, { inf, inf, inf, -inf, -inf, -inf });
+    parallel(static_cast<std::int64_t>(chunks),
+      [&](std::int64_t c)
+      {
+        std::array<double, 6>& box = boxes[static_cast<std::size_t>(c)];
+        const std::size_t last = std::min(n, (static_cast<std::size_t>(c) + 1) * Chunk);
+        for (std::size_t k = 9 * Chunk * static_cast<std::size_t>(c); k < 9 * last; ++k)
+        {
+          box[k % 3] = std::min(box[k % 3], this->Corners[k]);
+          box[3 + k % 3] = std::max(box[3 + k % 3], this->Corners[k]);
+        }
+      });
+    double lo[3] = { inf, inf, inf }, hi[3] = { -inf, -inf, -inf };
+    for (const auto& box : boxes)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = std::min(lo[a], box[a]);
+        hi[a] = std::max(hi[a], box[3 + a]);
       }
     }
     // Buckets are kept only where there are triangles (a hash of their position), so their size
@@ -208,48 +287,66 @@ private:
       this->Origin[a] = lo[a];
       this->Dims[a] = std::max(1, static_cast<int>(std::floor((hi[a] - lo[a]) / this->Size)) + 1);
     }
-    // Each (bucket, triangle) pair, the bucket numbered in the order first met; then the
-    // triangles grouped by bucket (a counting sort).
-    std::vector<std::uint32_t> pairs;
-    std::vector<std::uint64_t> counts;
-    this->ForBuckets(n,
-      [&](std::int64_t key, std::size_t t)
-      {
-        bool inserted;
-        const std::int32_t v =
-          this->Index.FindOrInsert(key, static_cast<std::int32_t>(counts.size()), inserted);
-        if (inserted)
-        {
-          counts.push_back(0);
-        }
-        ++counts[static_cast<std::size_t>(v)];
-        pairs.push_back(static_cast<std::uint32_t>(v));
-        pairs.push_back(static_cast<std::uint32_t>(t));
-      });
-    this->Start.assign(counts.size() + 1, 0);
-    for (std::size_t b = 0; b < counts.size(); ++b)
-    {
-      this->Start[b + 1] = this->Start[b] + counts[b];
-    }
-    this->Items.resize(this->Start.back());
-    std::vector<std::uint64_t> next(this->Start.begin(), this->Start.end() - 1);
-    for (std::size_t i = 0; i < pairs.size(); i += 2)
-    {
-      this->Items[next[pairs[i]]++] = pairs[i + 1];
-    }
   }
 
-  template <typename F>
-  void ForBuckets(std::size_t n, F&& f) const
+  /// put(place, key, triangle) for each pair, chunk c's from first[c] on.
+  template <typename Parallel, typename Put>
+  void Pairs(const std::vector<std::size_t>& first, Parallel& parallel, Put&& put) const
   {
-    for (std::size_t t = 0; t < n; ++t)
+    parallel(static_cast<std::int64_t>(first.size() - 1),
+      [&](std::int64_t c)
+      {
+        std::size_t at = first[static_cast<std::size_t>(c)];
+        this->ForBuckets(
+          static_cast<std::size_t>(c), [&](std::int64_t key, std::size_t t) { put(at++, key, t); });
+      });
+  }
+
+  /// The sorted pairs (keyAt(i), triangleAt(i)) as buckets: Start, Items, and the keys' index.
+  template <typename Parallel, typename KeyAt, typename TriangleAt>
+  void Group(std::size_t pairs, Parallel& parallel, KeyAt&& keyAt, TriangleAt&& triangleAt)
+  {
+    this->Items.resize(pairs);
+    const std::int64_t ranges = static_cast<std::int64_t>((pairs + Chunk - 1) / Chunk);
+    parallel(ranges,
+      [&](std::int64_t r)
+      {
+        const std::size_t last = std::min(pairs, (static_cast<std::size_t>(r) + 1) * Chunk);
+        for (std::size_t i = static_cast<std::size_t>(r) * Chunk; i < last; ++i)
+        {
+          this->Items[i] = triangleAt(i);
+        }
+      });
+    this->Start.clear();
+    for (std::size_t i = 0; i < pairs; ++i)
     {
-      const double* c = this->Corners.data() + 9 * t;
+      if (i == 0 || keyAt(i) != keyAt(i - 1))
+      {
+        this->Start.push_back(i);
+      }
+    }
+    this->Index = KeyMap(this->Start.size());
+    for (std::size_t b = 0; b < this->Start.size(); ++b)
+    {
+      bool inserted;
+      this->Index.FindOrInsert(keyAt(this->Start[b]), static_cast<std::int32_t>(b), inserted);
+    }
+    this->Start.push_back(pairs);
+  }
+
+  /// f(key, triangle) for each bucket of each triangle of chunk c, in triangle order.
+  template <typename F>
+  void ForBuckets(std::size_t c, F&& f) const
+  {
+    const std::size_t n = this->Corners.size() / 9;
+    for (std::size_t t = c * Chunk; t < std::min(n, (c + 1) * Chunk); ++t)
+    {
+      const double* p = this->Corners.data() + 9 * t;
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a)
       {
-        lo[a] = this->Cell(std::min({ c[a], c[3 + a], c[6 + a] }), a);
-        hi[a] = this->Cell(std::max({ c[a], c[3 + a], c[6 + a] }), a);
+        lo[a] = this->Cell(std::min({ p[a], p[3 + a], p[6 + a] }), a);
+        hi[a] = this->Cell(std::max({ p[a], p[3 + a], p[6 + a] }), a);
       }
       for (int z = lo[2]; z <= hi[2]; ++z)
       {
