@@ -2,19 +2,22 @@
 // std::bad_alloc, as the rest of the filters' allocations do (VTK's own path reports a failed
 // allocation through its error output, which needs memory too: with the memory exhausted it
 // aborted the process, measured in TestOutOfMemory), the count of a cell array's cells that
-// are not triangles, and an array's value ranges computed once where it is made.
+// are not triangles, an array's first value that is not finite, and an array's value ranges
+// computed once where it is made.
 #ifndef vtkRGArrays_h
 #define vtkRGArrays_h
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkAbstractArray.h"
 #include "vtkCellArray.h"
-
-class vtkDataArray;
+#include "vtkDataArray.h"
+#include "vtkRGParallel.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <new>
+#include <vector>
 
 namespace rgmc
 {
@@ -66,6 +69,59 @@ inline vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
     other += polys->GetCellSize(c) != 3;
   }
   return other;
+}
+
+/// The first value of `array` that is not a finite number, or -1: float and double arrays read
+/// straight in chunks on threads, any other type value by value.
+inline vtkIdType FirstNotFinite(vtkDataArray* array)
+{
+  const vtkIdType n = array->GetNumberOfValues();
+  auto scan = [n](const auto* values)
+  {
+    const vtkIdType chunk = 1 << 18;
+    const vtkIdType chunks = (n + chunk - 1) / chunk;
+    std::vector<vtkIdType> first(static_cast<std::size_t>(chunks), -1);
+    ParallelFor(chunks, 1,
+      [&](vtkIdType from, vtkIdType to)
+      {
+        for (vtkIdType c = from; c < to; ++c)
+        {
+          for (vtkIdType i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+          {
+            if (!std::isfinite(values[i]))
+            {
+              first[c] = i;
+              break;
+            }
+          }
+        }
+      });
+    for (vtkIdType at : first)
+    {
+      if (at >= 0)
+      {
+        return at;
+      }
+    }
+    return vtkIdType(-1);
+  };
+  if (auto* d = vtkAOSDataArrayTemplate<double>::FastDownCast(array))
+  {
+    return scan(d->GetPointer(0));
+  }
+  if (auto* f = vtkAOSDataArrayTemplate<float>::FastDownCast(array))
+  {
+    return scan(f->GetPointer(0));
+  }
+  const int components = std::max(1, array->GetNumberOfComponents());
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    if (!std::isfinite(array->GetComponent(i / components, static_cast<int>(i % components))))
+    {
+      return i;
+    }
+  }
+  return -1;
 }
 
 /// The slices [lo, hi] that a piece of `extent` shares with one of `previous` (the piece a

@@ -36,52 +36,73 @@ using Sending = std::array<vtkIdType, 3>;
 
 /// A message of triangles for blocks: the counts of own and halo triangles, (block, three
 /// vertex ids) for each (the own ones first), then the records of their vertices, each once, by
-/// increasing id.
+/// increasing id. Written in fixed chunks on threads (each part of the message has its place).
 inline void WriteTriangles(
   std::vector<vtkIdType>& words, std::vector<Sending>& going, const SurfacePart& part)
 {
   std::stable_partition(going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; });
   const auto halos =
     std::count_if(going.begin(), going.end(), [](const Sending& s) { return s[2]; });
+  const vtkIdType n = static_cast<vtkIdType>(going.size()), chunk = 65536;
   // The corners' vertices, by id (each written once), first: the message's size is then known.
-  std::vector<std::pair<vtkIdType, vtkIdType>> vertices; // (id, index in the part)
-  vertices.reserve(3 * going.size());
-  for (const Sending& s : going)
-  {
-    vtkIdType c[3];
-    part.Corners(static_cast<std::size_t>(s[1]), c);
-    for (vtkIdType v : c)
+  std::vector<std::pair<vtkIdType, vtkIdType>> vertices(3 * going.size()); // (id, part index)
+  rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
+    [&](vtkIdType from, vtkIdType to)
     {
-      vertices.emplace_back(part.Id(v), v);
-    }
-  }
+      for (vtkIdType i = from * chunk; i < std::min(n, to * chunk); ++i)
+      {
+        vtkIdType c[3];
+        part.Corners(static_cast<std::size_t>(going[i][1]), c);
+        for (int k = 0; k < 3; ++k)
+        {
+          vertices[3 * i + k] = { part.Id(c[k]), c[k] };
+        }
+      }
+    });
   rgmc::RadixSort(
-    vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); });
-  std::size_t distinct = 0;
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-  {
-    distinct += i == 0 || vertices[i].first != vertices[i - 1].first;
-  }
-  words.reserve(words.size() + 2 + 4 * going.size() + part.WordsPerVertex() * distinct);
-  words.push_back(static_cast<vtkIdType>(going.size()) - halos);
-  words.push_back(halos);
-  for (const Sending& s : going)
-  {
-    vtkIdType c[3];
-    part.Corners(static_cast<std::size_t>(s[1]), c);
-    words.push_back(s[0]);
-    for (vtkIdType v : c)
+    vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); },
+    rgmc::Tasks());
+  const vtkIdType corners = static_cast<vtkIdType>(vertices.size());
+  const vtkIdType chunks = (corners + chunk - 1) / chunk;
+  auto isFirst = [&vertices](vtkIdType i)
+  { return i == 0 || vertices[i].first != vertices[i - 1].first; };
+  const std::vector<std::size_t> before = rgmc::CountBefore(corners, chunk, isFirst);
+  const std::size_t start = words.size(), perVertex = part.WordsPerVertex();
+  const std::size_t records = start + 2 + 4 * going.size();
+  words.resize(records + perVertex * before.back());
+  words[start] = n - halos;
+  words[start + 1] = halos;
+  rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
+    [&](vtkIdType from, vtkIdType to)
     {
-      words.push_back(part.Id(v));
-    }
-  }
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-  {
-    if (i == 0 || vertices[i].first != vertices[i - 1].first)
+      for (vtkIdType i = from * chunk; i < std::min(n, to * chunk); ++i)
+      {
+        vtkIdType c[3];
+        part.Corners(static_cast<std::size_t>(going[i][1]), c);
+        vtkIdType* out = words.data() + start + 2 + 4 * i;
+        out[0] = going[i][0];
+        for (int k = 0; k < 3; ++k)
+        {
+          out[1 + k] = part.Id(c[k]);
+        }
+      }
+    });
+  rgmc::ParallelFor(chunks, 1,
+    [&](vtkIdType from, vtkIdType to)
     {
-      part.Write(vertices[i].second, words);
-    }
-  }
+      for (vtkIdType c = from; c < to; ++c)
+      {
+        vtkIdType* out = words.data() + records + perVertex * before[static_cast<std::size_t>(c)];
+        for (vtkIdType i = c * chunk; i < std::min(corners, (c + 1) * chunk); ++i)
+        {
+          if (isFirst(i))
+          {
+            part.Write(vertices[i].second, out);
+            out += perVertex;
+          }
+        }
+      }
+    });
 }
 
 /// Reads what WriteTriangles wrote: each triangle into its block's own or halo list

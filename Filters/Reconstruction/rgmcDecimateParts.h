@@ -7,6 +7,7 @@
 #include "rgmcDecimation.h"
 #include "rgmcRadixSort.h"
 #include "vtkRGMessage.h"
+#include "vtkRGParallel.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
@@ -65,18 +66,19 @@ public:
 
   std::size_t Words() const { return this->HasQuadrics ? 14 : 4; }
 
-  /// Message words of vertex `i`: id and position, then the quadric's 10 terms.
-  void Write(std::size_t i, std::vector<vtkIdType>& words) const
+  /// Message words of vertex `i` at `out` (Words() of them): id and position, then the
+  /// quadric's 10 terms.
+  void Write(std::size_t i, vtkIdType* out) const
   {
     const Vertex& v = this->Vertices[i];
-    words.push_back(v.Id);
+    *out++ = v.Id;
     for (double x : v.Point)
     {
-      words.push_back(rgmc::WordOf(x));
+      *out++ = rgmc::WordOf(x);
     }
     for (std::size_t k = 0; this->HasQuadrics && k < 10; ++k)
     {
-      words.push_back(rgmc::WordOf(this->Quadrics[i].Terms[k]));
+      *out++ = rgmc::WordOf(this->Quadrics[i].Terms[k]);
     }
   }
 
@@ -134,7 +136,8 @@ public:
       order[i] = { this->Vertices[i].Id, i };
     }
     rgmc::RadixSort(
-      order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); });
+      order, [](const std::pair<vtkIdType, std::size_t>& p) { return KeyOf(p.first); },
+      rgmc::Tasks());
     // Record i becomes record order[i].second: each cycle of the permutation walked once, its
     // places marked done by pointing them at themselves.
     for (std::size_t i = 0; i < n; ++i)
@@ -271,13 +274,18 @@ public:
       throw std::runtime_error("a rank's part of the surface has more than 2^31 vertices");
     }
     this->Triangles.resize(byId.size());
-    for (std::size_t t = 0; t < byId.size(); ++t)
-    {
-      for (int k = 0; k < 3; ++k)
+    const vtkIdType n = static_cast<vtkIdType>(byId.size()), chunk = 65536;
+    rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
+      [&](vtkIdType from, vtkIdType to)
       {
-        this->Triangles[t][k] = static_cast<std::int32_t>(this->Vertices.Find(byId[t][k]));
-      }
-    }
+        for (vtkIdType t = from * chunk; t < std::min(n, to * chunk); ++t)
+        {
+          for (int k = 0; k < 3; ++k)
+          {
+            this->Triangles[t][k] = static_cast<std::int32_t>(this->Vertices.Find(byId[t][k]));
+          }
+        }
+      });
     std::vector<Triangle>().swap(byId);
   }
 
@@ -360,20 +368,21 @@ public:
   }
   /// How many message words Write gives a vertex.
   std::size_t WordsPerVertex() const { return this->HasQuadrics() ? 14 : 4; }
-  /// Message words of vertex `v`: id and position, then its quadric's 10 terms if it has one.
-  void Write(vtkIdType v, std::vector<vtkIdType>& words) const
+  /// Message words of vertex `v` at `out` (WordsPerVertex() of them): id and position, then
+  /// its quadric's 10 terms if it has one.
+  void Write(vtkIdType v, vtkIdType* out) const
   {
     if (!this->Input)
     {
-      this->Vertices.Write(static_cast<std::size_t>(v), words);
+      this->Vertices.Write(static_cast<std::size_t>(v), out);
       return;
     }
     double p[3];
     this->Point(v, p);
-    words.push_back(this->Id(v));
+    *out++ = this->Id(v);
     for (double x : p)
     {
-      words.push_back(rgmc::WordOf(x));
+      *out++ = rgmc::WordOf(x);
     }
   }
 

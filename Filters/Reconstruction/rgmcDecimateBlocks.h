@@ -1,0 +1,208 @@
+// Decimate Surface's blocks on their rank: a block's mesh made from the triangles and vertex
+// records it was sent, simplified, and its kept collapses replayed and copied out as the rank's
+// part (vtkRGDecimate.cxx runs these in its passes; vtkRGDecimate.h says how the blocks are
+// placed).
+#ifndef rgmcDecimateBlocks_h
+#define rgmcDecimateBlocks_h
+
+#include "rgmcDecimateParts.h"
+#include "rgmcDecimation.h"
+#include "vtkRGParallel.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace rgmc
+{
+namespace decimate
+{
+
+/// The block's mesh in local indices from its triangles (by global ids) and the records in
+/// `seen`: a vertex of its own triangles that a halo triangle has too is shared with another
+/// block, so fixed. Its quadrics are summed here in the first pass, and carried after.
+inline void AssembleMesh(Block& block, const VertexTable& seen, bool areaWeighted)
+{
+  rgmc::DecimationBlock& mesh = block.Mesh;
+  for (const auto* list : { &block.Own, &block.Halo })
+  {
+    for (const Triangle& t : *list)
+    {
+      mesh.Ids.insert(mesh.Ids.end(), t.begin(), t.end());
+    }
+  }
+  SortDistinct(mesh.Ids);
+  const std::size_t n = mesh.Ids.size();
+  mesh.Points.resize(3 * n);
+  mesh.Quadrics.resize(n);
+  for (std::size_t v = 0; v < n; ++v)
+  {
+    const std::ptrdiff_t at = seen.Find(mesh.Ids[v]);
+    const Vertex& record = seen.Vertices[at];
+    std::copy(record.Point, record.Point + 3, mesh.Points.begin() + 3 * v);
+    if (seen.HasQuadrics)
+    {
+      mesh.Quadrics[v] = seen.Quadrics[at];
+    }
+  }
+  auto local = [&mesh](vtkIdType id)
+  {
+    return static_cast<int>(
+      std::lower_bound(mesh.Ids.begin(), mesh.Ids.end(), id) - mesh.Ids.begin());
+  };
+  std::vector<std::uint8_t> inOwn(n, 0), inHalo(n, 0);
+  for (const Triangle& t : block.Own)
+  {
+    mesh.Triangles.push_back({ local(t[0]), local(t[1]), local(t[2]) });
+    for (int v : mesh.Triangles.back())
+    {
+      inOwn[v] = 1;
+    }
+  }
+  for (const Triangle& t : block.Halo)
+  {
+    mesh.Halo.push_back({ local(t[0]), local(t[1]), local(t[2]) });
+    for (int v : mesh.Halo.back())
+    {
+      inHalo[v] = 1;
+    }
+  }
+  mesh.Fixed.resize(n);
+  for (std::size_t v = 0; v < n; ++v)
+  {
+    mesh.Fixed[v] = inOwn[v] & inHalo[v];
+  }
+  std::vector<Triangle>().swap(block.Own);
+  std::vector<Triangle>().swap(block.Halo);
+  mesh.SortTriangles();
+  if (!seen.HasQuadrics)
+  {
+    mesh.AreaWeighted = areaWeighted;
+    mesh.ComputeQuadrics();
+  }
+}
+
+/// The block simplified: its collapses' levels and its vertices, fixed or not, counted; with
+/// `dropMesh` (several waves) its mesh and collapses are freed, to be made again once the
+/// threshold is known.
+inline void SimplifyBlock(
+  Block& block, double maximumError, std::size_t maximumCollapses, bool dropMesh)
+{
+  block.Log = rgmc::Simplify(block.Mesh, maximumError, maximumCollapses);
+  block.Levels.resize(block.Log.size());
+  for (std::size_t c = 0; c < block.Log.size(); ++c)
+  {
+    block.Levels[c] = block.Log[c].Level;
+  }
+  std::vector<std::uint8_t> used(block.Mesh.Ids.size(), 0);
+  for (const auto& t : block.Mesh.Triangles)
+  {
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  }
+  for (std::size_t v = 0; v < used.size(); ++v)
+  {
+    block.Vertices += used[v];
+    block.Fixed += used[v] && block.Mesh.Fixed[v];
+  }
+  if (dropMesh)
+  {
+    block.Mesh = rgmc::DecimationBlock();
+    std::vector<rgmc::Collapse>().swap(block.Log);
+  }
+}
+
+/// The blocks' collapses at or below `level` (below it when `strictly`).
+inline vtkIdType CollapsesUpTo(const std::vector<Block>& blocks, double level, bool strictly)
+{
+  vtkIdType count = 0;
+  for (const Block& block : blocks)
+  {
+    auto end = strictly ? std::lower_bound(block.Levels.begin(), block.Levels.end(), level)
+                        : std::upper_bound(block.Levels.begin(), block.Levels.end(), level);
+    count += static_cast<vtkIdType>(end - block.Levels.begin());
+  }
+  return count;
+}
+
+/// The blocks' triangles (by global ids) and vertices after their kept collapses, block after
+/// block: what becomes the rank's part at the end of a pass.
+class CollapsedBlocks
+{
+public:
+  CollapsedBlocks() { this->Vertices.HasQuadrics = true; }
+
+  /// Replays the kept collapses of the blocks from `first` to `last` in parallel (each block
+  /// alone), simplifying them first when made `again`; then copies and frees each block, in
+  /// order.
+  void Apply(std::vector<Block>::iterator first, std::vector<Block>::iterator last, bool again,
+    double maximumError)
+  {
+    if (this->Surface.capacity() == 0)
+    {
+      this->Surface.reserve(this->Expected);
+      this->Vertices.Reserve(this->Expected / 2 + this->Expected / 16);
+    }
+    std::vector<std::vector<std::uint8_t>> used(static_cast<std::size_t>(last - first));
+    rgmc::ParallelFor(static_cast<vtkIdType>(last - first), 1,
+      [&](vtkIdType from, vtkIdType to)
+      {
+        for (vtkIdType b = from; b < to; ++b)
+        {
+          Block& block = *(first + b);
+          if (again)
+          {
+            block.Log = rgmc::Simplify(block.Mesh, maximumError, block.Keep);
+          }
+          rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
+          used[b].assign(block.Mesh.Ids.size(), 0);
+          for (const auto& t : block.Mesh.Triangles)
+          {
+            used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
+          }
+        }
+      });
+    for (auto block = first; block != last; ++block)
+    {
+      const std::size_t b = static_cast<std::size_t>(block - first);
+      this->Copy(*block, used[b]);
+      *block = Block{ block->Id, block->Wave, {}, {}, {}, {}, {}, 0, 0, 0 };
+      std::vector<std::uint8_t>().swap(used[b]);
+    }
+  }
+
+  std::vector<Triangle> Surface; // by global ids
+  VertexTable Vertices;          // of the triangles, as they come (Adopt sorts them)
+  vtkIdType Kept = 0;            // collapses
+  double Level = 0;              // the largest kept collapse's level
+  std::size_t Expected = 0;      // triangles, to size the lists once
+
+private:
+  void Copy(const Block& block, const std::vector<std::uint8_t>& used)
+  {
+    this->Kept += static_cast<vtkIdType>(block.Keep);
+    if (block.Keep > 0)
+    {
+      this->Level = std::max(this->Level, block.Levels[block.Keep - 1]);
+    }
+    const rgmc::DecimationBlock& mesh = block.Mesh;
+    for (const auto& t : mesh.Triangles)
+    {
+      this->Surface.push_back({ mesh.Ids[t[0]], mesh.Ids[t[1]], mesh.Ids[t[2]] });
+    }
+    for (std::size_t v = 0; v < used.size(); ++v)
+    {
+      if (used[v])
+      {
+        Vertex record;
+        record.Id = mesh.Ids[v];
+        std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, record.Point);
+        this->Vertices.Add(record, &mesh.Quadrics[v]);
+      }
+    }
+  }
+};
+
+} // namespace decimate
+} // namespace rgmc
+
+#endif
