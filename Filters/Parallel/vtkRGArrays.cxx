@@ -78,43 +78,39 @@ struct Extremes
 template <typename T>
 std::vector<Extremes<T>> ComponentExtremes(const T* values, vtkIdType tuples, int components)
 {
-  constexpr vtkIdType Chunk = vtkIdType(1) << 18;
-  const vtkIdType chunks = (tuples + Chunk - 1) / Chunk;
+  const vtkIdType chunk = 4 * rgmc::ElementChunk; // a comparison or two a value: larger chunks
+  const vtkIdType chunks = rgmc::ChunksOf(tuples, chunk);
   std::vector<Extremes<T>> partial(static_cast<std::size_t>(chunks * components));
-  rgmc::ParallelFor(chunks, 1,
-    [&](vtkIdType first, vtkIdType last)
+  rgmc::ForEachChunk(tuples, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType c = first; c < last; ++c)
+      Extremes<T>* e = partial.data() + c * components;
+      const T* v = values + begin * components;
+      if constexpr (std::is_floating_point<T>::value)
       {
-        Extremes<T>* e = partial.data() + c * components;
-        const vtkIdType end = std::min(tuples, (c + 1) * Chunk);
-        const T* v = values + c * Chunk * components;
-        if constexpr (std::is_floating_point<T>::value)
+        for (vtkIdType t = begin; t < end; ++t)
         {
-          for (vtkIdType t = c * Chunk; t < end; ++t)
-          {
-            for (int k = 0; k < components; ++k)
-            {
-              e[k].Add(*v++);
-            }
-          }
-        }
-        else
-        {
-          // Integers are all finite: a plain minimum and maximum, which the compiler vectorizes.
-          const vtkIdType n = end - c * Chunk;
           for (int k = 0; k < components; ++k)
           {
-            T low = e[k].AllLow, high = e[k].AllHigh;
-            for (vtkIdType t = 0; t < n; ++t)
-            {
-              low = std::min(low, v[t * components + k]);
-              high = std::max(high, v[t * components + k]);
-            }
-            e[k].AllLow = e[k].FiniteLow = low;
-            e[k].AllHigh = e[k].FiniteHigh = high;
-            e[k].AnyValue = e[k].AnyFinite = n > 0;
+            e[k].Add(*v++);
           }
+        }
+      }
+      else
+      {
+        // Integers are all finite: a plain minimum and maximum, which the compiler vectorizes.
+        const vtkIdType n = end - begin;
+        for (int k = 0; k < components; ++k)
+        {
+          T low = e[k].AllLow, high = e[k].AllHigh;
+          for (vtkIdType t = 0; t < n; ++t)
+          {
+            low = std::min(low, v[t * components + k]);
+            high = std::max(high, v[t * components + k]);
+          }
+          e[k].AllLow = e[k].FiniteLow = low;
+          e[k].AllHigh = e[k].FiniteHigh = high;
+          e[k].AnyValue = e[k].AnyFinite = n > 0;
         }
       }
     });

@@ -78,21 +78,17 @@ inline vtkIdType FirstNotFinite(vtkDataArray* array)
   const vtkIdType n = array->GetNumberOfValues();
   auto scan = [n](const auto* values)
   {
-    const vtkIdType chunk = 1 << 18;
-    const vtkIdType chunks = (n + chunk - 1) / chunk;
-    std::vector<vtkIdType> first(static_cast<std::size_t>(chunks), -1);
-    ParallelFor(chunks, 1,
-      [&](vtkIdType from, vtkIdType to)
+    const vtkIdType chunk = 4 * ElementChunk; // a test a value: larger chunks
+    std::vector<vtkIdType> first(static_cast<std::size_t>(ChunksOf(n, chunk)), -1);
+    ForEachChunk(n, chunk,
+      [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
-        for (vtkIdType c = from; c < to; ++c)
+        for (vtkIdType i = begin; i < end; ++i)
         {
-          for (vtkIdType i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+          if (!std::isfinite(values[i]))
           {
-            if (!std::isfinite(values[i]))
-            {
-              first[c] = i;
-              break;
-            }
+            first[c] = i;
+            break;
           }
         }
       });

@@ -68,25 +68,48 @@ void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
   }
 }
 
-/// The kernels' parallel(count, task) (rgmc::RadixSort's, for one): task(i) for every i in
+/// The elements a chunk holds in passes over many elements whose per-chunk results are put
+/// together in chunk order (ForEachChunk, CountBefore): a fixed number, so that the results
+/// are the same on any number of threads.
+constexpr vtkIdType ElementChunk = 65536;
+
+/// How many chunks of `chunk` elements cover [0, n).
+inline vtkIdType ChunksOf(vtkIdType n, vtkIdType chunk)
+{
+  return (n + chunk - 1) / chunk;
+}
+
+/// body(c, begin, end) for every chunk c = [begin, end) of [0, n), `chunk` elements each but
+/// the last, on threads through ParallelFor, one chunk a task.
+template <typename Body>
+void ForEachChunk(vtkIdType n, vtkIdType chunk, Body&& body)
+{
+  ParallelFor(ChunksOf(n, chunk), 1,
+    [&](vtkIdType from, vtkIdType to)
+    {
+      for (vtkIdType c = from; c < to; ++c)
+      {
+        body(c, c * chunk, std::min(n, (c + 1) * chunk));
+      }
+    });
+}
+
 /// before[c]: how many of the indices i < c * chunk, 0 <= i < n, have counted(i) true (a
 /// count per chunk on threads, then their sums in order); before has one entry per chunk and
 /// one more, the total.
 template <typename Counted>
 std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& counted)
 {
-  const vtkIdType chunks = (n + chunk - 1) / chunk;
-  std::vector<std::size_t> before(static_cast<std::size_t>(chunks) + 1, 0);
-  rgmc::ParallelFor(chunks, 1,
-    [&](vtkIdType from, vtkIdType to)
+  std::vector<std::size_t> before(static_cast<std::size_t>(ChunksOf(n, chunk)) + 1, 0);
+  ForEachChunk(n, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType c = from; c < to; ++c)
+      std::size_t count = 0;
+      for (vtkIdType i = begin; i < end; ++i)
       {
-        for (vtkIdType i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
-        {
-          before[static_cast<std::size_t>(c) + 1] += counted(i);
-        }
+        count += counted(i);
       }
+      before[static_cast<std::size_t>(c) + 1] = count;
     });
   for (std::size_t c = 0; c + 1 < before.size(); ++c)
   {
@@ -95,6 +118,7 @@ std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& cou
   return before;
 }
 
+/// The kernels' parallel(count, task) (rgmc::RadixSort's, for one): task(i) for every i in
 /// [0, count), one index a task, on vtkSMPTools' threads through ParallelFor.
 struct Tasks
 {

@@ -57,10 +57,6 @@ struct DistanceSurface
   double Hi[3] = { -std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
     -std::numeric_limits<double>::max() };
 
-  /// Chunks of points or cells a task (fixed: the order of the result never depends on the
-  /// threads).
-  static constexpr vtkIdType Chunk = 65536;
-
   explicit DistanceSurface(vtkPolyData* pd)
   {
     vtkPoints* points = pd->GetPoints();
@@ -111,22 +107,18 @@ private:
     auto kept = [ghost](vtkIdType i)
     { return !ghost || !(ghost[i] & vtkDataSetAttributes::DUPLICATEPOINT); };
     const vtkIdType n = points->GetNumberOfPoints();
-    const vtkIdType chunks = (n + Chunk - 1) / Chunk;
-    const std::vector<std::size_t> first = CountBefore(n, Chunk, kept);
+    const std::vector<std::size_t> first = CountBefore(n, ElementChunk, kept);
     this->Points.resize(3 * first.back());
-    ParallelFor(chunks, 1,
-      [&](vtkIdType from, vtkIdType to)
+    ForEachChunk(n, ElementChunk,
+      [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
-        for (vtkIdType c = from; c < to; ++c)
+        double* out = this->Points.data() + 3 * first[static_cast<std::size_t>(c)];
+        for (vtkIdType i = begin; i < end; ++i)
         {
-          double* out = this->Points.data() + 3 * first[static_cast<std::size_t>(c)];
-          for (vtkIdType i = c * Chunk; i < std::min(n, (c + 1) * Chunk); ++i)
+          if (kept(i))
           {
-            if (kept(i))
-            {
-              points->GetPoint(i, out);
-              out += 3;
-            }
+            points->GetPoint(i, out);
+            out += 3;
           }
         }
       });
@@ -136,38 +128,35 @@ private:
   template <typename Offset, typename Id>
   void ReadTriangles(vtkPoints* points, vtkIdType cells, const Offset* offsets, const Id* ids)
   {
-    const vtkIdType chunks = (cells + Chunk - 1) / Chunk;
-    std::vector<std::array<double, 6>> boxes(static_cast<std::size_t>(chunks));
+    std::vector<std::array<double, 6>> boxes(
+      static_cast<std::size_t>(ChunksOf(cells, ElementChunk)));
     auto isTriangle = [offsets](vtkIdType c) { return offsets[c + 1] - offsets[c] == 3; };
-    const std::vector<std::size_t> first = CountBefore(cells, Chunk, isTriangle);
+    const std::vector<std::size_t> first = CountBefore(cells, ElementChunk, isTriangle);
     this->Triangles.resize(9 * first.back());
-    ParallelFor(chunks, 1,
-      [&](vtkIdType from, vtkIdType to)
+    ForEachChunk(cells, ElementChunk,
+      [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
-        for (vtkIdType c = from; c < to; ++c)
+        std::array<double, 6>& box = boxes[static_cast<std::size_t>(c)];
+        std::copy(this->Lo, this->Lo + 3, box.begin());
+        std::copy(this->Hi, this->Hi + 3, box.begin() + 3);
+        double* t = this->Triangles.data() + 9 * first[static_cast<std::size_t>(c)];
+        for (vtkIdType i = begin; i < end; ++i)
         {
-          std::array<double, 6>& box = boxes[static_cast<std::size_t>(c)];
-          std::copy(this->Lo, this->Lo + 3, box.begin());
-          std::copy(this->Hi, this->Hi + 3, box.begin() + 3);
-          double* t = this->Triangles.data() + 9 * first[static_cast<std::size_t>(c)];
-          for (vtkIdType i = c * Chunk; i < std::min(cells, (c + 1) * Chunk); ++i)
+          if (!isTriangle(i))
           {
-            if (!isTriangle(i))
-            {
-              continue;
-            }
-            for (int k = 0; k < 3; ++k)
-            {
-              points->GetPoint(static_cast<vtkIdType>(ids[offsets[i] + k]), t + 3 * k);
-            }
-            CanonicalTriangle(t);
-            for (int k = 0; k < 9; ++k)
-            {
-              box[k % 3] = std::min(box[k % 3], t[k]);
-              box[3 + k % 3] = std::max(box[3 + k % 3], t[k]);
-            }
-            t += 9;
+            continue;
           }
+          for (int k = 0; k < 3; ++k)
+          {
+            points->GetPoint(static_cast<vtkIdType>(ids[offsets[i] + k]), t + 3 * k);
+          }
+          CanonicalTriangle(t);
+          for (int k = 0; k < 9; ++k)
+          {
+            box[k % 3] = std::min(box[k % 3], t[k]);
+            box[3 + k % 3] = std::max(box[3 + k % 3], t[k]);
+          }
+          t += 9;
         }
       });
     for (const auto& box : boxes)
@@ -251,33 +240,28 @@ inline std::vector<double> MeasureWithin(const std::vector<double>& points,
   SpanMark("distance: buckets");
   const TriangleBuckets buckets(triangles, bucket, Tasks());
   SpanMark("distance: nearest triangles");
-  const std::size_t n = points.size() / 3;
-  const vtkIdType grain = 4096;
-  const vtkIdType tasks = static_cast<vtkIdType>((n + grain - 1) / grain);
+  const vtkIdType n = static_cast<vtkIdType>(points.size() / 3);
+  const vtkIdType grain = 4096; // searches cost more than reads: smaller chunks than ElementChunk
+  const vtkIdType tasks = ChunksOf(n, grain);
   std::vector<DirectedDistance> parts(static_cast<std::size_t>(tasks));
   std::vector<std::vector<double>> far(static_cast<std::size_t>(tasks));
-  ParallelFor(tasks, 1,
-    [&](vtkIdType begin, vtkIdType end)
+  ForEachChunk(n, grain,
+    [&](vtkIdType task, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType task = begin; task < end; ++task)
+      DirectedDistance& part = parts[task];
+      for (vtkIdType i = begin; i < end; ++i)
       {
-        DirectedDistance& part = parts[task];
-        const std::size_t last =
-          std::min<std::size_t>(n, static_cast<std::size_t>(task + 1) * grain);
-        for (std::size_t i = static_cast<std::size_t>(task) * grain; i < last; ++i)
+        const double* p = points.data() + 3 * i;
+        const double d2 = buckets.Nearest2(p, limit);
+        if (d2 > limit * limit)
         {
-          const double* p = points.data() + 3 * i;
-          const double d2 = buckets.Nearest2(p, limit);
-          if (d2 > limit * limit)
-          {
-            far[task].insert(far[task].end(), p, p + 3);
-            continue;
-          }
-          const double d = std::sqrt(d2);
-          part.Max = std::max(part.Max, d);
-          part.Sum.Add(d);
-          ++part.Count;
+          far[task].insert(far[task].end(), p, p + 3);
+          continue;
         }
+        const double d = std::sqrt(d2);
+        part.Max = std::max(part.Max, d);
+        part.Sum.Add(d);
+        ++part.Count;
       }
     });
   std::vector<double> unresolved;

@@ -43,13 +43,13 @@ inline void WriteTriangles(
   std::stable_partition(going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; });
   const auto halos =
     std::count_if(going.begin(), going.end(), [](const Sending& s) { return s[2]; });
-  const vtkIdType n = static_cast<vtkIdType>(going.size()), chunk = 65536;
+  const vtkIdType n = static_cast<vtkIdType>(going.size()), chunk = rgmc::ElementChunk;
   // The corners' vertices, by id (each written once), first: the message's size is then known.
   std::vector<std::pair<vtkIdType, vtkIdType>> vertices(3 * going.size()); // (id, part index)
-  rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
-    [&](vtkIdType from, vtkIdType to)
+  rgmc::ForEachChunk(n, chunk,
+    [&](vtkIdType, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType i = from * chunk; i < std::min(n, to * chunk); ++i)
+      for (vtkIdType i = begin; i < end; ++i)
       {
         vtkIdType c[3];
         part.Corners(static_cast<std::size_t>(going[i][1]), c);
@@ -63,7 +63,6 @@ inline void WriteTriangles(
     vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); },
     rgmc::Tasks());
   const vtkIdType corners = static_cast<vtkIdType>(vertices.size());
-  const vtkIdType chunks = (corners + chunk - 1) / chunk;
   auto isFirst = [&vertices](vtkIdType i)
   { return i == 0 || vertices[i].first != vertices[i - 1].first; };
   const std::vector<std::size_t> before = rgmc::CountBefore(corners, chunk, isFirst);
@@ -72,10 +71,10 @@ inline void WriteTriangles(
   words.resize(records + perVertex * before.back());
   words[start] = n - halos;
   words[start + 1] = halos;
-  rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
-    [&](vtkIdType from, vtkIdType to)
+  rgmc::ForEachChunk(n, chunk,
+    [&](vtkIdType, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType i = from * chunk; i < std::min(n, to * chunk); ++i)
+      for (vtkIdType i = begin; i < end; ++i)
       {
         vtkIdType c[3];
         part.Corners(static_cast<std::size_t>(going[i][1]), c);
@@ -87,19 +86,16 @@ inline void WriteTriangles(
         }
       }
     });
-  rgmc::ParallelFor(chunks, 1,
-    [&](vtkIdType from, vtkIdType to)
+  rgmc::ForEachChunk(corners, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType c = from; c < to; ++c)
+      vtkIdType* out = words.data() + records + perVertex * before[static_cast<std::size_t>(c)];
+      for (vtkIdType i = begin; i < end; ++i)
       {
-        vtkIdType* out = words.data() + records + perVertex * before[static_cast<std::size_t>(c)];
-        for (vtkIdType i = c * chunk; i < std::min(corners, (c + 1) * chunk); ++i)
+        if (isFirst(i))
         {
-          if (isFirst(i))
-          {
-            part.Write(vertices[i].second, out);
-            out += perVertex;
-          }
+          part.Write(vertices[i].second, out);
+          out += perVertex;
         }
       }
     });

@@ -274,11 +274,10 @@ public:
       throw std::runtime_error("a rank's part of the surface has more than 2^31 vertices");
     }
     this->Triangles.resize(byId.size());
-    const vtkIdType n = static_cast<vtkIdType>(byId.size()), chunk = 65536;
-    rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
-      [&](vtkIdType from, vtkIdType to)
+    rgmc::ForEachChunk(static_cast<vtkIdType>(byId.size()), rgmc::ElementChunk,
+      [&](vtkIdType, vtkIdType begin, vtkIdType end)
       {
-        for (vtkIdType t = from * chunk; t < std::min(n, to * chunk); ++t)
+        for (vtkIdType t = begin; t < end; ++t)
         {
           for (int k = 0; k < 3; ++k)
           {

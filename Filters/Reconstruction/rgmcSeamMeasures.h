@@ -37,20 +37,16 @@ template <typename T, typename I>
 rgmc::TriangleSums SumTriangles(
   const SeamPiece<T, I>& piece, const T* positions, const double centre[3], double scale)
 {
-  const vtkIdType grain = 65536;
-  const vtkIdType blocks = (piece.NumTriangles + grain - 1) / grain;
-  std::vector<rgmc::TriangleSums> partial(static_cast<std::size_t>(blocks));
-  rgmc::ParallelFor(blocks, 1,
-    [&](vtkIdType first, vtkIdType last)
+  const vtkIdType n = piece.NumTriangles;
+  std::vector<rgmc::TriangleSums> partial(
+    static_cast<std::size_t>(rgmc::ChunksOf(n, rgmc::ElementChunk)));
+  rgmc::ForEachChunk(n, rgmc::ElementChunk,
+    [&](vtkIdType b, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType b = first; b < last; ++b)
-      {
-        // Summed here, then stored: neighbouring blocks' sums share cache lines.
-        rgmc::TriangleSums sum;
-        sum.Add(positions, piece.Triangles, b * grain,
-          std::min(piece.NumTriangles, (b + 1) * grain), centre, scale);
-        partial[b] = sum;
-      }
+      // Summed here, then stored: neighbouring blocks' sums share cache lines.
+      rgmc::TriangleSums sum;
+      sum.Add(positions, piece.Triangles, begin, end, centre, scale);
+      partial[b] = sum;
     });
   rgmc::TriangleSums sums;
   for (const rgmc::TriangleSums& p : partial)
@@ -76,42 +72,37 @@ std::vector<double> BorderEdges(
       }
     });
   // Blocks of triangles on threads, each packing its own edges, joined in triangle order.
-  const vtkIdType grain = 65536;
   std::vector<std::vector<double>> parts(
-    static_cast<std::size_t>((piece.NumTriangles + grain - 1) / grain));
-  rgmc::ParallelFor(static_cast<vtkIdType>(parts.size()), 1,
-    [&](vtkIdType firstBlock, vtkIdType lastBlock)
+    static_cast<std::size_t>(rgmc::ChunksOf(piece.NumTriangles, rgmc::ElementChunk)));
+  rgmc::ForEachChunk(piece.NumTriangles, rgmc::ElementChunk,
+    [&](vtkIdType block, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType block = firstBlock; block < lastBlock; ++block)
+      std::vector<double> packed;
+      for (vtkIdType t = begin; t < end; ++t)
       {
-        std::vector<double> packed;
-        for (vtkIdType t = block * grain; t < std::min(piece.NumTriangles, (block + 1) * grain);
-             ++t)
+        for (int c = 0; c < 3; ++c)
         {
-          for (int c = 0; c < 3; ++c)
+          const vtkIdType a = static_cast<vtkIdType>(piece.Triangles[3 * t + c]);
+          const vtkIdType b = static_cast<vtkIdType>(piece.Triangles[3 * t + (c + 1) % 3]);
+          if (!(faces[a] & faces[b]))
           {
-            const vtkIdType a = static_cast<vtkIdType>(piece.Triangles[3 * t + c]);
-            const vtkIdType b = static_cast<vtkIdType>(piece.Triangles[3 * t + (c + 1) % 3]);
-            if (!(faces[a] & faces[b]))
-            {
-              continue;
-            }
-            rgmc::BorderEdge e;
-            e.From = piece.Numbering.Gid[a];
-            e.To = piece.Numbering.Gid[b];
-            e.FromFaces = faces[a];
-            e.ToFaces = faces[b];
-            double x[3];
-            std::copy_n(positions + 3 * a, 3, x);
-            box.ToIndex(x, e.FromIndex);
-            std::copy_n(positions + 3 * b, 3, x);
-            box.ToIndex(x, e.ToIndex);
-            packed.resize(packed.size() + rgmc::BorderEdge::Words);
-            e.Pack(packed.data() + packed.size() - rgmc::BorderEdge::Words);
+            continue;
           }
+          rgmc::BorderEdge e;
+          e.From = piece.Numbering.Gid[a];
+          e.To = piece.Numbering.Gid[b];
+          e.FromFaces = faces[a];
+          e.ToFaces = faces[b];
+          double x[3];
+          std::copy_n(positions + 3 * a, 3, x);
+          box.ToIndex(x, e.FromIndex);
+          std::copy_n(positions + 3 * b, 3, x);
+          box.ToIndex(x, e.ToIndex);
+          packed.resize(packed.size() + rgmc::BorderEdge::Words);
+          e.Pack(packed.data() + packed.size() - rgmc::BorderEdge::Words);
         }
-        parts[block] = std::move(packed);
       }
+      parts[block] = std::move(packed);
     });
   std::size_t size = 0;
   for (const std::vector<double>& part : parts)

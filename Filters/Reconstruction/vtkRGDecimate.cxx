@@ -324,29 +324,25 @@ void vtkRGDecimate::ReadPartBounds(Run& run, double bounds[6])
   // Over the triangles' corners (a vertex met again changes nothing), in fixed chunks on
   // threads, then in chunk order: minima are exact in any order.
   const vtkIdType n = static_cast<vtkIdType>(part.NumberOfTriangles());
-  const vtkIdType chunk = 65536;
-  const vtkIdType chunks = (n + chunk - 1) / chunk;
-  std::vector<std::array<double, 6>> found(static_cast<std::size_t>(chunks));
-  rgmc::ParallelFor(chunks, 1,
-    [&](vtkIdType from, vtkIdType to)
+  const vtkIdType chunk = rgmc::ElementChunk;
+  std::vector<std::array<double, 6>> found(static_cast<std::size_t>(rgmc::ChunksOf(n, chunk)));
+  rgmc::ForEachChunk(n, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType c = from; c < to; ++c)
+      std::array<double, 6>& box = found[static_cast<std::size_t>(c)];
+      std::copy(bounds, bounds + 6, box.begin());
+      for (vtkIdType t = begin; t < end; ++t)
       {
-        std::array<double, 6>& box = found[static_cast<std::size_t>(c)];
-        std::copy(bounds, bounds + 6, box.begin());
-        for (vtkIdType t = c * chunk; t < std::min(n, (c + 1) * chunk); ++t)
+        vtkIdType corners[3];
+        part.Corners(static_cast<std::size_t>(t), corners);
+        for (vtkIdType v : corners)
         {
-          vtkIdType corners[3];
-          part.Corners(static_cast<std::size_t>(t), corners);
-          for (vtkIdType v : corners)
+          double p[3];
+          part.Point(v, p);
+          for (int a = 0; a < 3; ++a)
           {
-            double p[3];
-            part.Point(v, p);
-            for (int a = 0; a < 3; ++a)
-            {
-              box[a] = std::min(box[a], p[a]);
-              box[3 + a] = std::min(box[3 + a], -p[a]);
-            }
+            box[a] = std::min(box[a], p[a]);
+            box[3 + a] = std::min(box[3 + a], -p[a]);
           }
         }
       }
@@ -404,11 +400,10 @@ void vtkRGDecimate::CountBlockTriangles(Run& run, std::vector<vtkIdType>& counts
   const vtkIdType n = static_cast<vtkIdType>(part.NumberOfTriangles());
   run.PartBlock.resize(static_cast<std::size_t>(n));
   // The blocks on threads, in fixed chunks of triangles; the counts after, in order.
-  const vtkIdType chunk = 65536;
-  rgmc::ParallelFor((n + chunk - 1) / chunk, 1,
-    [&](vtkIdType from, vtkIdType to)
+  rgmc::ForEachChunk(n, rgmc::ElementChunk,
+    [&](vtkIdType, vtkIdType begin, vtkIdType end)
     {
-      for (vtkIdType t = from * chunk; t < std::min(n, to * chunk); ++t)
+      for (vtkIdType t = begin; t < end; ++t)
       {
         vtkIdType c[3];
         part.Corners(static_cast<std::size_t>(t), c);

@@ -11,6 +11,7 @@
 #include "vtkSMPTools.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -240,6 +241,59 @@ void TestCountBefore()
   RGMC_CHECK(none.size() == 1 && none[0] == 0, "no indices: one entry, 0");
 }
 
+/// ForEachChunk: every chunk once with c = begin / chunk, [begin, end) its own indices (the last
+/// chunk short), every index in exactly one chunk, on 1, 2, 16 and 64 threads and while
+/// recording; nothing for an empty range.
+void TestForEachChunk()
+{
+  const vtkIdType n = 100003, chunk = 4096, chunks = rgmc::ChunksOf(n, chunk);
+  RGMC_CHECK(chunks == 25 && rgmc::ChunksOf(0, chunk) == 0 && rgmc::ChunksOf(chunk, chunk) == 1,
+    "ChunksOf rounds up: " << chunks);
+  auto visit = [&](std::vector<std::atomic<int>>& seen, std::vector<std::atomic<int>>& calls)
+  {
+    rgmc::ForEachChunk(n, chunk,
+      [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+      {
+        const bool right =
+          c >= 0 && c < chunks && begin == c * chunk && end == std::min(n, (c + 1) * chunk);
+        calls[static_cast<std::size_t>(std::min(std::max(c, vtkIdType(0)), chunks - 1))] +=
+          right ? 1 : 1000;
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          ++seen[static_cast<std::size_t>(i)];
+        }
+      });
+  };
+  auto once = [](const std::vector<std::atomic<int>>& counts)
+  {
+    return std::all_of(
+      counts.begin(), counts.end(), [](const std::atomic<int>& k) { return k == 1; });
+  };
+  for (int threads : { 1, 2, 16, 64, 0 })
+  {
+    std::vector<std::atomic<int>> seen(static_cast<std::size_t>(n));
+    std::vector<std::atomic<int>> calls(static_cast<std::size_t>(chunks));
+    if (threads > 0)
+    {
+      vtkSMPTools::LocalScope(
+        vtkSMPTools::Config{ threads, "STDThread", false }, [&]() { visit(seen, calls); });
+    }
+    else
+    {
+      rgmc::SpanRecorder recorder;
+      recorder.Start();
+      visit(seen, calls);
+      recorder.Stop();
+    }
+    RGMC_CHECK(
+      once(calls), "each chunk once, with its bounds, on " << threads << " threads (0: recording)");
+    RGMC_CHECK(once(seen), "each index once on " << threads << " threads (0: recording)");
+  }
+  int empty = 0;
+  rgmc::ForEachChunk(0, chunk, [&](vtkIdType, vtkIdType, vtkIdType) { ++empty; });
+  RGMC_CHECK(empty == 0, "no indices: no chunk");
+}
+
 } // namespace
 
 int main()
@@ -248,5 +302,6 @@ int main()
   TestPrefixAndExceptions();
   TestSortAndThreads();
   TestCountBefore();
+  TestForEachChunk();
   return rgmc_test::Result("TestSpanProfile");
 }
