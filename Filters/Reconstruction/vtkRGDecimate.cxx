@@ -5,6 +5,7 @@
 #include "rgmcDecimateDistance.h"
 #include "rgmcDecimateMessages.h"
 #include "rgmcDecimateParts.h"
+#include "rgmcDecimateShared.h"
 #include "rgmcDecimation.h"
 #include "rgmcRadixSort.h"
 #include "vtkRGArrays.h"
@@ -500,101 +501,19 @@ bool vtkRGDecimate::FindSharedVertices(Run& run)
 
 //------------------------------------------------------------------------------
 // (vertex id, vertex, block) for each block of each of the part's vertices, to the vertex's
-// rank.
+// rank (rgmcDecimateShared.h).
 void vtkRGDecimate::ListVertexBlocks(Run& run, Messages& outgoing)
 {
-  const int size = run.Ranks.Size;
-  const SurfacePart& part = run.Part;
-  const std::size_t nv = part.NumberOfVertices();
-  // Each vertex's first block, and its other blocks apart (few vertices have any).
-  std::vector<std::int32_t> first(nv, -1);
-  std::vector<std::pair<vtkIdType, vtkIdType>> more;
-  for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
-  {
-    vtkIdType c[3];
-    part.Corners(t, c);
-    for (vtkIdType v : c)
-    {
-      if (first[v] < 0)
-      {
-        first[v] = run.PartBlock[t];
-      }
-      else if (first[v] != run.PartBlock[t])
-      {
-        more.emplace_back(v, run.PartBlock[t]);
-      }
-    }
-  }
-  std::sort(more.begin(), more.end());
-  more.erase(std::unique(more.begin(), more.end()), more.end());
-  auto send = [&](vtkIdType v, vtkIdType block)
-  {
-    const vtkIdType id = part.Id(v);
-    auto& words = outgoing[static_cast<std::size_t>(id % size)];
-    words.push_back(id);
-    words.push_back(v);
-    words.push_back(block);
-  };
-  for (std::size_t v = 0; v < nv; ++v)
-  {
-    if (first[v] >= 0)
-    {
-      send(static_cast<vtkIdType>(v), first[v]);
-    }
-  }
-  for (const auto& vb : more)
-  {
-    send(vb.first, vb.second);
-  }
+  const LowestBlocks lowest(run.Part, run.PartBlock);
+  WriteVertexBlocks(run.Part, lowest, OtherBlocks(run.Part, run.PartBlock, lowest), outgoing);
 }
 
 //------------------------------------------------------------------------------
 // At the vertices' rank: to each rank that asked about a vertex in several blocks, (its index
 // of the vertex, block) for each of them.
-void vtkRGDecimate::AnswerSharedVertices(Run& run, Messages& asked, Messages& answers)
+void vtkRGDecimate::AnswerSharedVertices(Run&, Messages& asked, Messages& answers)
 {
-  const int size = run.Ranks.Size;
-  // (vertex id, block, asking rank, its index of the vertex)
-  std::vector<std::array<vtkIdType, 4>> all;
-  for (int r = 0; r < size; ++r)
-  {
-    const auto& words = asked[r];
-    for (std::size_t at = 0; at + 2 < words.size(); at += 3)
-    {
-      all.push_back({ words[at], words[at + 2], r, words[at + 1] });
-    }
-    std::vector<vtkIdType>().swap(asked[r]);
-  }
-  rgmc::RadixSort(
-    all, [](const std::array<vtkIdType, 4>& e) { return KeyOf(e[0]); }, rgmc::Tasks());
-  std::vector<vtkIdType> blocks;
-  std::vector<std::pair<vtkIdType, vtkIdType>> askers;
-  for (std::size_t first = 0, last; first < all.size(); first = last)
-  {
-    blocks.clear();
-    askers.clear();
-    for (last = first; last < all.size() && all[last][0] == all[first][0]; ++last)
-    {
-      blocks.push_back(all[last][1]);
-      askers.emplace_back(all[last][2], all[last][3]);
-    }
-    SortDistinct(blocks);
-    if (blocks.size() < 2)
-    {
-      continue;
-    }
-    std::sort(askers.begin(), askers.end());
-    askers.erase(std::unique(askers.begin(), askers.end()), askers.end());
-    for (const auto& asker : askers)
-    {
-      auto& words = answers[asker.first];
-      for (vtkIdType block : blocks)
-      {
-        words.push_back(asker.second);
-        words.push_back(block);
-      }
-    }
-  }
+  rgmc::decimate::AnswerSharedVertices(AskedRecords(asked), answers);
 }
 
 //------------------------------------------------------------------------------

@@ -1,0 +1,255 @@
+// Decimate Surface's shared vertices, on threads: the part's vertices with their blocks, sent
+// to each vertex's rank (its id modulo the ranks), and there the vertices in several blocks
+// told back to the ranks that asked (vtkRGDecimate::FindSharedVertices runs these). What a
+// rank sends or answers is a set: its order never reaches the result, which the receivers sort.
+#ifndef rgmcDecimateShared_h
+#define rgmcDecimateShared_h
+
+#include "rgmcDecimateParts.h"
+#include "rgmcRadixSort.h"
+#include "vtkRGParallel.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace rgmc
+{
+namespace decimate
+{
+
+using VertexBlocks = std::vector<std::vector<vtkIdType>>; // one message per rank
+
+/// Each vertex's lowest block among its triangles' blocks (partBlock), NoBlock for a vertex
+/// no triangle uses: a minimum, so the same whatever order the threads meet the triangles in.
+class LowestBlocks
+{
+public:
+  static constexpr std::int32_t NoBlock = std::numeric_limits<std::int32_t>::max();
+
+  LowestBlocks(const SurfacePart& part, const std::vector<std::int32_t>& partBlock)
+    : Lowest(part.NumberOfVertices())
+  {
+    const vtkIdType nv = static_cast<vtkIdType>(this->Lowest.size());
+    ForEachChunk(nv, ElementChunk,
+      [&](vtkIdType, vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType v = begin; v < end; ++v)
+        {
+          this->Lowest[v].store(NoBlock, std::memory_order_relaxed);
+        }
+      });
+    ForEachChunk(static_cast<vtkIdType>(part.NumberOfTriangles()), ElementChunk,
+      [&](vtkIdType, vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType t = begin; t < end; ++t)
+        {
+          vtkIdType c[3];
+          part.Corners(static_cast<std::size_t>(t), c);
+          for (vtkIdType v : c)
+          {
+            std::atomic<std::int32_t>& lowest = this->Lowest[v];
+            std::int32_t now = lowest.load(std::memory_order_relaxed);
+            while (partBlock[t] < now &&
+              !lowest.compare_exchange_weak(now, partBlock[t], std::memory_order_relaxed))
+            {
+            }
+          }
+        }
+      });
+  }
+
+  std::int32_t operator[](vtkIdType v) const
+  {
+    return this->Lowest[v].load(std::memory_order_relaxed);
+  }
+
+  vtkIdType Size() const { return static_cast<vtkIdType>(this->Lowest.size()); }
+
+private:
+  std::vector<std::atomic<std::int32_t>> Lowest;
+};
+
+/// The (vertex, block) pairs of the triangles' corners whose block is not the vertex's lowest,
+/// sorted, each once (few vertices have any).
+inline std::vector<std::pair<vtkIdType, vtkIdType>> OtherBlocks(
+  const SurfacePart& part, const std::vector<std::int32_t>& partBlock, const LowestBlocks& lowest)
+{
+  const vtkIdType nt = static_cast<vtkIdType>(part.NumberOfTriangles());
+  std::vector<std::vector<std::pair<vtkIdType, vtkIdType>>> found(
+    static_cast<std::size_t>(ChunksOf(nt, ElementChunk)));
+  ForEachChunk(nt, ElementChunk,
+    [&](vtkIdType chunk, vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType t = begin; t < end; ++t)
+      {
+        vtkIdType c[3];
+        part.Corners(static_cast<std::size_t>(t), c);
+        for (vtkIdType v : c)
+        {
+          if (partBlock[t] != lowest[v])
+          {
+            found[chunk].emplace_back(v, partBlock[t]);
+          }
+        }
+      }
+    });
+  std::vector<std::pair<vtkIdType, vtkIdType>> more;
+  for (const auto& pairs : found)
+  {
+    more.insert(more.end(), pairs.begin(), pairs.end());
+  }
+  std::sort(more.begin(), more.end());
+  more.erase(std::unique(more.begin(), more.end()), more.end());
+  return more;
+}
+
+/// (vertex id, vertex, block) for the lowest block of every used vertex and for each of `more`,
+/// to the vertex's rank: the lowest blocks written in fixed chunks of vertices on threads, each
+/// chunk at its place in each rank's message (counted first), `more` after them.
+inline void WriteVertexBlocks(const SurfacePart& part, const LowestBlocks& lowest,
+  const std::vector<std::pair<vtkIdType, vtkIdType>>& more, VertexBlocks& outgoing)
+{
+  const std::size_t size = outgoing.size();
+  const vtkIdType nv = lowest.Size();
+  const std::size_t chunks = static_cast<std::size_t>(ChunksOf(nv, ElementChunk));
+  std::vector<std::size_t> at(chunks * size, 0); // chunk c's first record in rank r's message
+  ForEachChunk(nv, ElementChunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        at[c * size + static_cast<std::size_t>(part.Id(v)) % size] +=
+          lowest[v] != LowestBlocks::NoBlock;
+      }
+    });
+  for (std::size_t r = 0; r < size; ++r)
+  {
+    std::size_t records = 0;
+    for (std::size_t c = 0; c < chunks; ++c)
+    {
+      records += std::exchange(at[c * size + r], records);
+    }
+    outgoing[r].resize(3 * records);
+  }
+  ForEachChunk(nv, ElementChunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        if (lowest[v] != LowestBlocks::NoBlock)
+        {
+          const vtkIdType id = part.Id(v);
+          const std::size_t r = static_cast<std::size_t>(id) % size;
+          vtkIdType* out = outgoing[r].data() + 3 * at[c * size + r]++;
+          out[0] = id;
+          out[1] = v;
+          out[2] = lowest[v];
+        }
+      }
+    });
+  for (const auto& vb : more)
+  {
+    const vtkIdType id = part.Id(vb.first);
+    auto& words = outgoing[static_cast<std::size_t>(id) % size];
+    words.insert(words.end(), { id, vb.first, vb.second });
+  }
+}
+
+/// (vertex id, block, asking rank, its index of the vertex) for every record asked, by vertex
+/// id; `asked` is emptied.
+inline std::vector<std::array<vtkIdType, 4>> AskedRecords(VertexBlocks& asked)
+{
+  std::vector<std::size_t> first(asked.size() + 1, 0);
+  for (std::size_t r = 0; r < asked.size(); ++r)
+  {
+    first[r + 1] = first[r] + asked[r].size() / 3;
+  }
+  std::vector<std::array<vtkIdType, 4>> all(first.back());
+  for (std::size_t r = 0; r < asked.size(); ++r)
+  {
+    const std::vector<vtkIdType>& words = asked[r];
+    ForEachChunk(static_cast<vtkIdType>(first[r + 1] - first[r]), ElementChunk,
+      [&](vtkIdType, vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          all[first[r] + i] = { words[3 * i], words[3 * i + 2], static_cast<vtkIdType>(r),
+            words[3 * i + 1] };
+        }
+      });
+    std::vector<vtkIdType>().swap(asked[r]);
+  }
+  RadixSort(
+    all, [](const std::array<vtkIdType, 4>& e) { return KeyOf(e[0]); }, Tasks());
+  return all;
+}
+
+/// To each rank that asked about a vertex in several blocks, (its index of the vertex, block)
+/// for each of them, in order of vertex id. The records (AskedRecords) are cut into fixed
+/// chunks, each taking the vertices that start in it, answered on threads and joined in order.
+inline void AnswerSharedVertices(
+  const std::vector<std::array<vtkIdType, 4>>& all, VertexBlocks& answers)
+{
+  const std::size_t size = answers.size();
+  const vtkIdType n = static_cast<vtkIdType>(all.size());
+  auto vertexStart = [&all, n](vtkIdType i) // the first record of a vertex at or after i
+  {
+    while (i > 0 && i < n && all[i][0] == all[i - 1][0])
+    {
+      ++i;
+    }
+    return i;
+  };
+  std::vector<VertexBlocks> parts(static_cast<std::size_t>(ChunksOf(n, ElementChunk)));
+  ForEachChunk(n, ElementChunk,
+    [&](vtkIdType chunk, vtkIdType begin, vtkIdType end)
+    {
+      VertexBlocks& part = parts[chunk];
+      part.resize(size);
+      std::vector<vtkIdType> blocks;
+      std::vector<std::pair<vtkIdType, vtkIdType>> askers;
+      for (vtkIdType first = vertexStart(begin), last, stop = vertexStart(end); first < stop;
+           first = last)
+      {
+        blocks.clear();
+        askers.clear();
+        for (last = first; last < n && all[last][0] == all[first][0]; ++last)
+        {
+          blocks.push_back(all[last][1]);
+          askers.emplace_back(all[last][2], all[last][3]);
+        }
+        SortDistinct(blocks);
+        if (blocks.size() < 2)
+        {
+          continue;
+        }
+        std::sort(askers.begin(), askers.end());
+        askers.erase(std::unique(askers.begin(), askers.end()), askers.end());
+        for (const auto& asker : askers)
+        {
+          auto& words = part[static_cast<std::size_t>(asker.first)];
+          for (vtkIdType block : blocks)
+          {
+            words.insert(words.end(), { asker.second, block });
+          }
+        }
+      }
+    });
+  for (const VertexBlocks& part : parts)
+  {
+    for (std::size_t r = 0; r < size; ++r)
+    {
+      answers[r].insert(answers[r].end(), part[r].begin(), part[r].end());
+    }
+  }
+}
+
+} // namespace decimate
+} // namespace rgmc
+
+#endif

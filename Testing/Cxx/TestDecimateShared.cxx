@@ -1,0 +1,203 @@
+// Decimate Surface's shared vertices on threads (rgmcDecimateShared.h) against plain serial
+// versions of the same rules, on 1, 2, 16 and 64 threads: the records each rank is sent (as a
+// set, to the rank of the vertex's id) and the answers (to the word, in order). The surfaces are
+// large enough for many chunks, so vertices whose triangles or records straddle a chunk's end
+// are met.
+#include "rgmcCheck.h"
+#include "rgmcDecimateShared.h"
+
+#include "vtkCellArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSMPTools.h"
+
+#include <array>
+#include <map>
+#include <random>
+#include <set>
+#include <vector>
+
+namespace
+{
+
+using rgmc::decimate::VertexBlocks;
+using Record = std::array<vtkIdType, 3>; // (vertex id, vertex, block)
+
+/// Triangles over `nv` vertices with shuffled global ids; the triangles' blocks in runs, so
+/// that most vertices have one block and some several.
+struct Soup
+{
+  vtkNew<vtkPolyData> Mesh;
+  std::vector<std::int32_t> Blocks;
+
+  Soup(vtkIdType nv, vtkIdType nt, std::mt19937_64& random)
+  {
+    vtkNew<vtkPoints> points;
+    points->SetNumberOfPoints(nv);
+    vtkNew<vtkIdTypeArray> ids;
+    ids->SetNumberOfValues(nv);
+    std::vector<vtkIdType> order(static_cast<std::size_t>(nv));
+    for (vtkIdType v = 0; v < nv; ++v)
+    {
+      points->SetPoint(v, static_cast<double>(v), 0, 0);
+      order[v] = 3 * v + 7; // ids neither dense nor in the vertices' order
+    }
+    std::shuffle(order.begin(), order.end(), random);
+    for (vtkIdType v = 0; v < nv; ++v)
+    {
+      ids->SetValue(v, order[v]);
+    }
+    vtkNew<vtkCellArray> polys;
+    std::int32_t block = 0;
+    for (vtkIdType t = 0; t < nt; ++t)
+    {
+      // Corners near each other in index (as a real surface's are), now and then far.
+      auto below = [&random](vtkIdType n) { return static_cast<vtkIdType>(random() % n); };
+      const vtkIdType a = below(nv);
+      const vtkIdType pts[3] = { a, (a + 1 + below(5)) % nv,
+        below(50) == 0 ? below(nv) : (a + 2 + below(9)) % nv };
+      polys->InsertNextCell(3, pts);
+      block = random() % 1000 == 0 ? static_cast<std::int32_t>(random() % 40) : block;
+      this->Blocks.push_back(block);
+    }
+    this->Mesh->SetPoints(points);
+    this->Mesh->SetPolys(polys);
+    this->Mesh->GetPointData()->SetGlobalIds(ids);
+  }
+};
+
+std::set<Record> SerialRecords(
+  const rgmc::decimate::SurfacePart& part, const std::vector<std::int32_t>& blocks)
+{
+  std::set<Record> records;
+  for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
+  {
+    vtkIdType c[3];
+    part.Corners(t, c);
+    for (vtkIdType v : c)
+    {
+      records.insert({ part.Id(v), v, blocks[t] });
+    }
+  }
+  return records;
+}
+
+void TestVertexBlocks()
+{
+  std::mt19937_64 random(5);
+  Soup soup(150000, 250000, random);
+  rgmc::decimate::SurfacePart part;
+  part.Read(soup.Mesh);
+  const std::set<Record> expected = SerialRecords(part, soup.Blocks);
+  for (int threads : { 1, 2, 16, 64 })
+  {
+    for (std::size_t ranks : { 1, 3 })
+    {
+      VertexBlocks outgoing(ranks);
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]()
+        {
+          const rgmc::decimate::LowestBlocks lowest(part, soup.Blocks);
+          rgmc::decimate::WriteVertexBlocks(
+            part, lowest, OtherBlocks(part, soup.Blocks, lowest), outgoing);
+        });
+      std::set<Record> sent;
+      std::size_t count = 0, misplaced = 0;
+      for (std::size_t r = 0; r < ranks; ++r)
+      {
+        for (std::size_t at = 0; at + 2 < outgoing[r].size(); at += 3)
+        {
+          const Record record{ outgoing[r][at], outgoing[r][at + 1], outgoing[r][at + 2] };
+          sent.insert(record);
+          misplaced += static_cast<std::size_t>(record[0]) % ranks != r;
+          ++count;
+        }
+      }
+      RGMC_CHECK(sent == expected && count == expected.size(),
+        "each (vertex, block) once: " << count << " records, " << sent.size() << " distinct, "
+                                      << expected.size() << " expected, on " << threads
+                                      << " threads, " << ranks << " ranks");
+      RGMC_CHECK(misplaced == 0, misplaced << " records sent to another rank than the id's");
+    }
+  }
+}
+
+/// Records as three ranks would send them: vertices in one block or several, asked by one rank
+/// or more, some records repeated.
+VertexBlocks Asked(std::mt19937_64& random)
+{
+  VertexBlocks asked(3);
+  for (vtkIdType id = 0; id < 120000; ++id)
+  {
+    const int records = 1 + static_cast<int>(random() % 6);
+    for (int k = 0; k < records; ++k)
+    {
+      const vtkIdType rank = static_cast<vtkIdType>(random() % 3);
+      const vtkIdType index = id * 10 + rank; // a rank's index of the vertex
+      const vtkIdType block = static_cast<vtkIdType>(random() % (id % 4 == 0 ? 1 : 5));
+      asked[rank].insert(asked[rank].end(), { 5 * id + 1, index, block });
+    }
+  }
+  return asked;
+}
+
+VertexBlocks SerialAnswers(const VertexBlocks& asked)
+{
+  std::map<vtkIdType, std::pair<std::set<vtkIdType>, std::set<std::pair<vtkIdType, vtkIdType>>>>
+    byId;
+  for (std::size_t r = 0; r < asked.size(); ++r)
+  {
+    for (std::size_t at = 0; at + 2 < asked[r].size(); at += 3)
+    {
+      auto& entry = byId[asked[r][at]];
+      entry.first.insert(asked[r][at + 2]);
+      entry.second.insert({ static_cast<vtkIdType>(r), asked[r][at + 1] });
+    }
+  }
+  VertexBlocks answers(asked.size());
+  for (const auto& vertex : byId)
+  {
+    if (vertex.second.first.size() < 2)
+    {
+      continue;
+    }
+    for (const auto& asker : vertex.second.second)
+    {
+      for (vtkIdType block : vertex.second.first)
+      {
+        answers[asker.first].insert(answers[asker.first].end(), { asker.second, block });
+      }
+    }
+  }
+  return answers;
+}
+
+void TestAnswers()
+{
+  std::mt19937_64 random(9);
+  const VertexBlocks asked = Asked(random);
+  const VertexBlocks expected = SerialAnswers(asked);
+  RGMC_CHECK(!expected[0].empty() && !expected[1].empty() && !expected[2].empty(),
+    "every rank has answers to check");
+  for (int threads : { 1, 2, 16, 64 })
+  {
+    VertexBlocks copy = asked, answers(asked.size());
+    vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+      [&]() { rgmc::decimate::AnswerSharedVertices(rgmc::decimate::AskedRecords(copy), answers); });
+    RGMC_CHECK(
+      answers == expected, "the answers equal the serial ones on " << threads << " threads");
+    RGMC_CHECK(copy[0].empty() && copy[2].empty(), "the records asked are let go");
+  }
+}
+
+} // namespace
+
+int main()
+{
+  TestVertexBlocks();
+  TestAnswers();
+  return rgmc_test::Result("TestDecimateShared");
+}
