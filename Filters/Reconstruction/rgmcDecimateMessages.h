@@ -45,7 +45,8 @@ inline void WriteTriangles(
     std::count_if(going.begin(), going.end(), [](const Sending& s) { return s[2]; });
   const vtkIdType n = static_cast<vtkIdType>(going.size()), chunk = rgmc::ElementChunk;
   // The corners' vertices, by id (each written once), first: the message's size is then known.
-  std::vector<std::pair<vtkIdType, vtkIdType>> vertices(3 * going.size()); // (id, part index)
+  using IdAndIndex = std::array<vtkIdType, 2>; // (id, part index)
+  rgmc::OverwriteVector<IdAndIndex> vertices(3 * going.size());
   rgmc::ForEachChunk(n, chunk,
     [&](vtkIdType, vtkIdType begin, vtkIdType end)
     {
@@ -60,11 +61,10 @@ inline void WriteTriangles(
       }
     });
   rgmc::RadixSort(
-    vertices, [](const std::pair<vtkIdType, vtkIdType>& p) { return KeyOf(p.first); },
-    rgmc::Tasks());
+    vertices, [](const IdAndIndex& p) { return KeyOf(p[0]); }, rgmc::Tasks());
   const vtkIdType corners = static_cast<vtkIdType>(vertices.size());
   auto isFirst = [&vertices](vtkIdType i)
-  { return i == 0 || vertices[i].first != vertices[i - 1].first; };
+  { return i == 0 || vertices[i][0] != vertices[i - 1][0]; };
   const std::vector<std::size_t> before = rgmc::CountBefore(corners, chunk, isFirst);
   const std::size_t start = words.size(), perVertex = part.WordsPerVertex();
   const std::size_t records = start + 2 + 4 * going.size();
@@ -94,39 +94,82 @@ inline void WriteTriangles(
       {
         if (isFirst(i))
         {
-          part.Write(vertices[i].second, out);
+          part.Write(vertices[i][1], out);
           out += perVertex;
         }
       }
     });
 }
 
-/// Reads what WriteTriangles wrote: each triangle into its block's own or halo list
-/// (`blockWithId`; a block this rank does not own is an error), the vertex records into `table`.
-template <typename BlockWithId>
-void ReadTriangles(
-  const std::vector<vtkIdType>& words, BlockWithId&& blockWithId, VertexTable& table)
+/// Reads what WriteTriangles wrote: each triangle appended to its block's own or halo list
+/// (`blocks`, this rank's, by increasing id; a block this rank does not own is an error), the
+/// vertex records to `table`. On threads: each chunk of triangles finds their blocks and counts
+/// them per block, which gives each chunk its places in the blocks' lists (in message order, as
+/// a serial read would append them); the records go to their places.
+inline void ReadTriangles(
+  const std::vector<vtkIdType>& words, std::vector<Block>& blocks, VertexTable& table)
 {
   if (words.size() < 2)
   {
     return;
   }
   const vtkIdType own = words[0], n = words[0] + words[1];
-  std::size_t at = 2;
-  for (vtkIdType t = 0; t < n; ++t, at += 4)
-  {
-    Block* block = blockWithId(words[at]);
-    if (!block)
+  // At most 64 chunks (any cut gives the same lists): counts per chunk and block list.
+  const vtkIdType chunk = std::max(rgmc::ElementChunk, rgmc::ChunksOf(n, 64));
+  const std::size_t lists = 2 * blocks.size(), chunks = rgmc::ChunksOf(n, chunk);
+  rgmc::OverwriteVector<std::int32_t> listOf(static_cast<std::size_t>(n));
+  std::vector<std::size_t> at(chunks * lists, 0); // chunk c's first place in list l
+  rgmc::ForEachChunk(n, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
     {
-      throw std::runtime_error("triangles came to a rank that does not own their block");
-    }
-    (t < own ? block->Own : block->Halo).push_back({ words[at + 1], words[at + 2], words[at + 3] });
-  }
-  const std::size_t size = table.Words();
-  for (; at + size <= words.size(); at += size)
-  {
-    table.Read(words.data() + at);
-  }
+      for (vtkIdType t = begin; t < end; ++t)
+      {
+        const vtkIdType id = words[2 + 4 * t];
+        const auto block = std::lower_bound(blocks.begin(), blocks.end(), id,
+          [](const Block& b, vtkIdType key) { return b.Id < key; });
+        if (block == blocks.end() || block->Id != id)
+        {
+          throw std::runtime_error("triangles came to a rank that does not own their block");
+        }
+        listOf[t] = static_cast<std::int32_t>(2 * (block - blocks.begin()) + (t < own ? 0 : 1));
+        ++at[c * lists + listOf[t]];
+      }
+    });
+  auto list = [&blocks](std::size_t l) -> std::vector<Triangle>&
+  { return l % 2 ? blocks[l / 2].Halo : blocks[l / 2].Own; };
+  rgmc::ParallelFor(static_cast<vtkIdType>(lists), 1,
+    [&](vtkIdType first, vtkIdType last)
+    {
+      for (std::size_t l = first; l < static_cast<std::size_t>(last); ++l)
+      {
+        std::size_t size = list(l).size();
+        for (std::size_t c = 0; c < chunks; ++c)
+        {
+          size += std::exchange(at[c * lists + l], size);
+        }
+        list(l).resize(size);
+      }
+    });
+  rgmc::ForEachChunk(n, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType t = begin; t < end; ++t)
+      {
+        const vtkIdType* w = words.data() + 2 + 4 * t;
+        list(listOf[t])[at[c * lists + listOf[t]]++] = { w[1], w[2], w[3] };
+      }
+    });
+  const std::size_t start = 2 + 4 * static_cast<std::size_t>(n), size = table.Words();
+  const std::size_t first = table.Vertices.size(), records = (words.size() - start) / size;
+  table.Grow(records);
+  rgmc::ForEachChunk(static_cast<vtkIdType>(records), rgmc::ElementChunk,
+    [&](vtkIdType, vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType i = begin; i < end; ++i)
+      {
+        table.ReadAt(first + i, words.data() + start + size * i);
+      }
+    });
 }
 
 } // namespace decimate

@@ -60,7 +60,7 @@ struct Vertex
 class VertexTable
 {
 public:
-  std::vector<Vertex> Vertices; // by increasing id once sorted
+  rgmc::OverwriteVector<Vertex> Vertices; // by increasing id once sorted
   std::vector<rgmc::Quadric> Quadrics;
   bool HasQuadrics = false;
 
@@ -82,23 +82,25 @@ public:
     }
   }
 
-  void Read(const vtkIdType* words)
+  /// Room for `more` records after the present ones, to be written by ReadAt.
+  void Grow(std::size_t more)
   {
-    Vertex v;
+    this->Vertices.resize(this->Vertices.size() + more);
+    this->Quadrics.resize(this->HasQuadrics ? this->Vertices.size() : 0);
+  }
+
+  /// Record i from the message words at `words` (as Write wrote them).
+  void ReadAt(std::size_t i, const vtkIdType* words)
+  {
+    Vertex& v = this->Vertices[i];
     v.Id = words[0];
     for (int k = 0; k < 3; ++k)
     {
       v.Point[k] = rgmc::RealOf(words[1 + k]);
     }
-    this->Vertices.push_back(v);
-    if (this->HasQuadrics)
+    for (std::size_t k = 0; this->HasQuadrics && k < 10; ++k)
     {
-      rgmc::Quadric q;
-      for (int k = 0; k < 10; ++k)
-      {
-        q.Terms[k] = rgmc::RealOf(words[4 + k]);
-      }
-      this->Quadrics.push_back(q);
+      this->Quadrics[i].Terms[k] = rgmc::RealOf(words[4 + k]);
     }
   }
 
@@ -187,7 +189,7 @@ public:
 
   void Clear()
   {
-    std::vector<Vertex>().swap(this->Vertices);
+    decltype(this->Vertices)().swap(this->Vertices);
     std::vector<rgmc::Quadric>().swap(this->Quadrics);
   }
 };

@@ -160,16 +160,17 @@ inline void WriteVertexBlocks(const SurfacePart& part, const LowestBlocks& lowes
   }
 }
 
-/// (vertex id, block, asking rank, its index of the vertex) for every record asked, by vertex
-/// id; `asked` is emptied.
-inline std::vector<std::array<vtkIdType, 4>> AskedRecords(VertexBlocks& asked)
+using AskedRecord = std::array<vtkIdType, 4>; // (vertex id, block, asking rank, its index)
+
+/// Every record asked (AskedRecord), by vertex id; `asked` is emptied.
+inline OverwriteVector<AskedRecord> AskedRecords(VertexBlocks& asked)
 {
   std::vector<std::size_t> first(asked.size() + 1, 0);
   for (std::size_t r = 0; r < asked.size(); ++r)
   {
     first[r + 1] = first[r] + asked[r].size() / 3;
   }
-  std::vector<std::array<vtkIdType, 4>> all(first.back());
+  OverwriteVector<AskedRecord> all(first.back());
   for (std::size_t r = 0; r < asked.size(); ++r)
   {
     const std::vector<vtkIdType>& words = asked[r];
@@ -185,15 +186,14 @@ inline std::vector<std::array<vtkIdType, 4>> AskedRecords(VertexBlocks& asked)
     std::vector<vtkIdType>().swap(asked[r]);
   }
   RadixSort(
-    all, [](const std::array<vtkIdType, 4>& e) { return KeyOf(e[0]); }, Tasks());
+    all, [](const AskedRecord& e) { return KeyOf(e[0]); }, Tasks());
   return all;
 }
 
 /// To each rank that asked about a vertex in several blocks, (its index of the vertex, block)
 /// for each of them, in order of vertex id. The records (AskedRecords) are cut into fixed
 /// chunks, each taking the vertices that start in it, answered on threads and joined in order.
-inline void AnswerSharedVertices(
-  const std::vector<std::array<vtkIdType, 4>>& all, VertexBlocks& answers)
+inline void AnswerSharedVertices(const OverwriteVector<AskedRecord>& all, VertexBlocks& answers)
 {
   const std::size_t size = answers.size();
   const vtkIdType n = static_cast<vtkIdType>(all.size());

@@ -125,13 +125,6 @@ struct vtkRGDecimate::Run
   }
   static int WaveKey(const Block& b) { return b.Wave; }
   static int WaveKey(int wave) { return wave; }
-
-  Block* BlockWithId(vtkIdType id)
-  {
-    auto at = std::lower_bound(this->Blocks.begin(), this->Blocks.end(), id,
-      [](const Block& b, vtkIdType key) { return b.Id < key; });
-    return at != this->Blocks.end() && at->Id == id ? &*at : nullptr;
-  }
 };
 
 //------------------------------------------------------------------------------
@@ -618,8 +611,7 @@ void vtkRGDecimate::AssembleBlocks(Run& run, int wave, Messages& incoming)
   seen.HasQuadrics = run.Part.HasQuadrics();
   for (auto& words : incoming)
   {
-    ReadTriangles(
-      words, [&run](vtkIdType id) { return run.BlockWithId(id); }, seen);
+    ReadTriangles(words, run.Blocks, seen);
     std::vector<vtkIdType>().swap(words); // read: its memory goes back at once
   }
   seen.SortDistinct();

@@ -1,9 +1,12 @@
-// Decimate Surface's shared vertices on threads (rgmcDecimateShared.h) against plain serial
-// versions of the same rules, on 1, 2, 16 and 64 threads: the records each rank is sent (as a
-// set, to the rank of the vertex's id) and the answers (to the word, in order). The surfaces are
+// Decimate Surface's shared vertices and its reading of the blocks' triangles on threads
+// (rgmcDecimateShared.h, rgmcDecimateMessages.h) against plain serial versions of the same
+// rules, on 1, 2, 16 and 64 threads: the records each rank is sent (as a set, to the rank of the
+// vertex's id), the answers (to the word, in order), the blocks' lists and vertex records read
+// from a message (in message order, after what the lists held). The surfaces are
 // large enough for many chunks, so vertices whose triangles or records straddle a chunk's end
 // are met.
 #include "rgmcCheck.h"
+#include "rgmcDecimateMessages.h"
 #include "rgmcDecimateShared.h"
 
 #include "vtkCellArray.h"
@@ -18,6 +21,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <stdexcept>
 #include <vector>
 
 namespace
@@ -193,11 +197,112 @@ void TestAnswers()
   }
 }
 
+/// A message as WriteTriangles lays it out: own and halo triangles for blocks 10, 20, ..., then
+/// vertex records (with quadrics when `quadrics`).
+std::vector<vtkIdType> Message(std::mt19937_64& random, vtkIdType own, vtkIdType halo,
+  std::size_t records, bool quadrics, int blocks)
+{
+  std::vector<vtkIdType> words{ own, halo };
+  for (vtkIdType t = 0; t < own + halo; ++t)
+  {
+    const vtkIdType block = 10 * (1 + static_cast<vtkIdType>(random() % blocks));
+    words.insert(words.end(),
+      { block, static_cast<vtkIdType>(random() % 1000), static_cast<vtkIdType>(random() % 1000),
+        t });
+  }
+  for (std::size_t i = 0; i < records * (quadrics ? 14 : 4); ++i)
+  {
+    words.push_back(static_cast<vtkIdType>(random() >> 2));
+  }
+  return words;
+}
+
+void TestReadTriangles()
+{
+  std::mt19937_64 random(3);
+  for (bool quadrics : { false, true })
+  {
+    const int blocks = 37;
+    const std::vector<vtkIdType> first = Message(random, 5, 3, 7, quadrics, blocks);
+    const std::vector<vtkIdType> second = Message(random, 200000, 90000, 150000, quadrics, blocks);
+    // The serial reading: each triangle appended to its list, each record after the others.
+    std::vector<rgmc::decimate::Block> expected(blocks);
+    for (int b = 0; b < blocks; ++b)
+    {
+      expected[b].Id = 10 * (b + 1);
+    }
+    std::vector<std::array<vtkIdType, 14>> expectedRecords;
+    for (const auto* words : { &first, &second })
+    {
+      const vtkIdType n = (*words)[0] + (*words)[1];
+      for (vtkIdType t = 0; t < n; ++t)
+      {
+        const vtkIdType* w = words->data() + 2 + 4 * t;
+        auto& block = expected[static_cast<std::size_t>(w[0] / 10 - 1)];
+        (t < (*words)[0] ? block.Own : block.Halo).push_back({ w[1], w[2], w[3] });
+      }
+      const std::size_t size = quadrics ? 14 : 4;
+      for (std::size_t at = 2 + 4 * n; at + size <= words->size(); at += size)
+      {
+        std::array<vtkIdType, 14> record{};
+        std::copy_n(words->data() + at, size, record.begin());
+        expectedRecords.push_back(record);
+      }
+    }
+    for (int threads : { 1, 2, 16, 64 })
+    {
+      std::vector<rgmc::decimate::Block> read(blocks);
+      for (int b = 0; b < blocks; ++b)
+      {
+        read[b].Id = 10 * (b + 1);
+      }
+      rgmc::decimate::VertexTable table;
+      table.HasQuadrics = quadrics;
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]()
+        {
+          rgmc::decimate::ReadTriangles(first, read, table);
+          rgmc::decimate::ReadTriangles(second, read, table);
+        });
+      bool same = table.Vertices.size() == expectedRecords.size();
+      for (int b = 0; same && b < blocks; ++b)
+      {
+        same = read[b].Own == expected[b].Own && read[b].Halo == expected[b].Halo;
+      }
+      for (std::size_t i = 0; same && i < expectedRecords.size(); ++i)
+      {
+        std::vector<vtkIdType> written(table.Words());
+        table.Write(i, written.data());
+        same = std::equal(written.begin(), written.end(), expectedRecords[i].begin());
+      }
+      RGMC_CHECK(same,
+        "the lists and records read equal the serial reading on "
+          << threads << " threads" << (quadrics ? ", with quadrics" : ""));
+    }
+  }
+  // A triangle for a block the rank does not own.
+  std::vector<rgmc::decimate::Block> some(2);
+  some[0].Id = 10;
+  some[1].Id = 30;
+  rgmc::decimate::VertexTable table;
+  bool refused = false;
+  try
+  {
+    rgmc::decimate::ReadTriangles(Message(random, 100000, 0, 0, false, 3), some, table);
+  }
+  catch (const std::runtime_error&)
+  {
+    refused = true;
+  }
+  RGMC_CHECK(refused, "a triangle for a block not owned is an error");
+}
+
 } // namespace
 
 int main()
 {
   TestVertexBlocks();
   TestAnswers();
+  TestReadTriangles();
   return rgmc_test::Result("TestDecimateShared");
 }

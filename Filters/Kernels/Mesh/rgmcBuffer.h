@@ -17,6 +17,7 @@
 #include <memory>
 #include <new>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace rgmc
@@ -145,6 +146,42 @@ struct LargeArrayAllocator
 /// A std::vector that may be large (LargeArrayAllocator).
 template <typename T>
 using LargeVector = std::vector<T, LargeArrayAllocator<T>>;
+
+/// LargeArrayAllocator whose vectors leave the values they grow by unset (default-initialized:
+/// nothing is written for plain values), for arrays sized first and then written whole, on
+/// threads: their pages are then first touched, and faulted in, by the threads that fill them,
+/// not zeroed on one thread before. Aggregates (std::array) stay unset; std::pair's constructor
+/// zeroes it.
+template <typename T>
+struct OverwriteAllocator : LargeArrayAllocator<T>
+{
+  using value_type = T;
+  template <typename U>
+  struct rebind
+  {
+    using other = OverwriteAllocator<U>;
+  };
+  OverwriteAllocator() = default;
+  template <typename U>
+  OverwriteAllocator(const OverwriteAllocator<U>&) noexcept
+  {
+  }
+  template <typename U>
+  void construct(U* at) noexcept(std::is_nothrow_default_constructible<U>::value)
+  {
+    ::new (static_cast<void*>(at)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* at, Args&&... args)
+  {
+    ::new (static_cast<void*>(at)) U(std::forward<Args>(args)...);
+  }
+};
+
+/// A std::vector sized, then written whole (OverwriteAllocator): resize leaves the new values
+/// unset.
+template <typename T>
+using OverwriteVector = std::vector<T, OverwriteAllocator<T>>;
 
 template <typename T>
 class Buffer
