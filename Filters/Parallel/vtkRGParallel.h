@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <exception>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 namespace rgmc
@@ -94,28 +95,60 @@ void ForEachChunk(vtkIdType n, vtkIdType chunk, Body&& body)
     });
 }
 
+/// Where each chunk of [0, n) puts its elements in several outputs filled in chunk order (a
+/// rank's message, a block's list), so that every output is the same on any number of threads.
+/// At(c, d) is chunk c's first place in output d, End[d] the output's end once all are in.
+struct ChunkPlaces
+{
+  std::size_t Outputs = 0;
+  std::vector<std::size_t> Places; // Places[c * Outputs + d]
+  std::vector<std::size_t> End;
+
+  std::size_t& At(vtkIdType c, std::size_t d)
+  {
+    return this->Places[static_cast<std::size_t>(c) * this->Outputs + d];
+  }
+};
+
+/// count(c, begin, end, counts) adds to counts[d] how many elements of chunk c = [begin, end)
+/// go to output d (on threads, one chunk a task, counts zeroed); the counts are then summed in
+/// chunk order from start[d], output d's first place, so chunk c's elements in output d follow
+/// those of every chunk before it.
+template <typename Count>
+ChunkPlaces PlaceChunks(vtkIdType n, vtkIdType chunk, std::vector<std::size_t> start, Count&& count)
+{
+  ChunkPlaces places;
+  places.Outputs = start.size();
+  places.Places.assign(static_cast<std::size_t>(ChunksOf(n, chunk)) * places.Outputs, 0);
+  ForEachChunk(n, chunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end) { count(c, begin, end, &places.At(c, 0)); });
+  places.End = std::move(start);
+  for (std::size_t i = 0; i < places.Places.size(); i += places.Outputs)
+  {
+    for (std::size_t d = 0; d < places.Outputs; ++d)
+    {
+      places.End[d] += std::exchange(places.Places[i + d], places.End[d]);
+    }
+  }
+  return places;
+}
+
 /// before[c]: how many of the indices i < c * chunk, 0 <= i < n, have counted(i) true (a
 /// count per chunk on threads, then their sums in order); before has one entry per chunk and
 /// one more, the total.
 template <typename Counted>
 std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& counted)
 {
-  std::vector<std::size_t> before(static_cast<std::size_t>(ChunksOf(n, chunk)) + 1, 0);
-  ForEachChunk(n, chunk,
-    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+  ChunkPlaces places = PlaceChunks(n, chunk, { 0 },
+    [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
     {
-      std::size_t count = 0;
       for (vtkIdType i = begin; i < end; ++i)
       {
-        count += counted(i);
+        counts[0] += counted(i);
       }
-      before[static_cast<std::size_t>(c) + 1] = count;
     });
-  for (std::size_t c = 0; c + 1 < before.size(); ++c)
-  {
-    before[c + 1] += before[c];
-  }
-  return before;
+  places.Places.push_back(places.End[0]);
+  return std::move(places.Places);
 }
 
 /// The kernels' parallel(count, task) (rgmc::RadixSort's, for one): task(i) for every i in

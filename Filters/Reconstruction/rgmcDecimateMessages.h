@@ -116,11 +116,16 @@ inline void ReadTriangles(
   const vtkIdType own = words[0], n = words[0] + words[1];
   // At most 64 chunks (any cut gives the same lists): counts per chunk and block list.
   const vtkIdType chunk = std::max(rgmc::ElementChunk, rgmc::ChunksOf(n, 64));
-  const std::size_t lists = 2 * blocks.size(), chunks = rgmc::ChunksOf(n, chunk);
+  auto list = [&blocks](std::size_t l) -> std::vector<Triangle>&
+  { return l % 2 ? blocks[l / 2].Halo : blocks[l / 2].Own; };
+  std::vector<std::size_t> sizes(2 * blocks.size());
+  for (std::size_t l = 0; l < sizes.size(); ++l)
+  {
+    sizes[l] = list(l).size();
+  }
   rgmc::OverwriteVector<std::int32_t> listOf(static_cast<std::size_t>(n));
-  std::vector<std::size_t> at(chunks * lists, 0); // chunk c's first place in list l
-  rgmc::ForEachChunk(n, chunk,
-    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+  rgmc::ChunkPlaces places = rgmc::PlaceChunks(n, chunk, std::move(sizes),
+    [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
     {
       for (vtkIdType t = begin; t < end; ++t)
       {
@@ -132,22 +137,15 @@ inline void ReadTriangles(
           throw std::runtime_error("triangles came to a rank that does not own their block");
         }
         listOf[t] = static_cast<std::int32_t>(2 * (block - blocks.begin()) + (t < own ? 0 : 1));
-        ++at[c * lists + listOf[t]];
+        ++counts[listOf[t]];
       }
     });
-  auto list = [&blocks](std::size_t l) -> std::vector<Triangle>&
-  { return l % 2 ? blocks[l / 2].Halo : blocks[l / 2].Own; };
-  rgmc::ParallelFor(static_cast<vtkIdType>(lists), 1,
+  rgmc::ParallelFor(static_cast<vtkIdType>(places.Outputs), 1,
     [&](vtkIdType first, vtkIdType last)
     {
       for (std::size_t l = first; l < static_cast<std::size_t>(last); ++l)
       {
-        std::size_t size = list(l).size();
-        for (std::size_t c = 0; c < chunks; ++c)
-        {
-          size += std::exchange(at[c * lists + l], size);
-        }
-        list(l).resize(size);
+        list(l).resize(places.End[l]);
       }
     });
   rgmc::ForEachChunk(n, chunk,
@@ -156,7 +154,7 @@ inline void ReadTriangles(
       for (vtkIdType t = begin; t < end; ++t)
       {
         const vtkIdType* w = words.data() + 2 + 4 * t;
-        list(listOf[t])[at[c * lists + listOf[t]]++] = { w[1], w[2], w[3] };
+        list(listOf[t])[places.At(c, listOf[t])++] = { w[1], w[2], w[3] };
       }
     });
   const std::size_t start = 2 + 4 * static_cast<std::size_t>(n), size = table.Words();

@@ -116,25 +116,17 @@ inline void WriteVertexBlocks(const SurfacePart& part, const LowestBlocks& lowes
 {
   const std::size_t size = outgoing.size();
   const vtkIdType nv = lowest.Size();
-  const std::size_t chunks = static_cast<std::size_t>(ChunksOf(nv, ElementChunk));
-  std::vector<std::size_t> at(chunks * size, 0); // chunk c's first record in rank r's message
-  ForEachChunk(nv, ElementChunk,
-    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+  ChunkPlaces records = PlaceChunks(nv, ElementChunk, std::vector<std::size_t>(size, 0),
+    [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
     {
       for (vtkIdType v = begin; v < end; ++v)
       {
-        at[c * size + static_cast<std::size_t>(part.Id(v)) % size] +=
-          lowest[v] != LowestBlocks::NoBlock;
+        counts[static_cast<std::size_t>(part.Id(v)) % size] += lowest[v] != LowestBlocks::NoBlock;
       }
     });
   for (std::size_t r = 0; r < size; ++r)
   {
-    std::size_t records = 0;
-    for (std::size_t c = 0; c < chunks; ++c)
-    {
-      records += std::exchange(at[c * size + r], records);
-    }
-    outgoing[r].resize(3 * records);
+    outgoing[r].resize(3 * records.End[r]);
   }
   ForEachChunk(nv, ElementChunk,
     [&](vtkIdType c, vtkIdType begin, vtkIdType end)
@@ -145,7 +137,7 @@ inline void WriteVertexBlocks(const SurfacePart& part, const LowestBlocks& lowes
         {
           const vtkIdType id = part.Id(v);
           const std::size_t r = static_cast<std::size_t>(id) % size;
-          vtkIdType* out = outgoing[r].data() + 3 * at[c * size + r]++;
+          vtkIdType* out = outgoing[r].data() + 3 * records.At(c, r)++;
           out[0] = id;
           out[1] = v;
           out[2] = lowest[v];

@@ -3,7 +3,8 @@
 // the sums the definitions give; a loop inside a task is part of the task; a mark inside a task,
 // or with no recorder, does nothing; the prefix of a filter inside another; an exception leaves
 // the recorder usable; ParallelSort takes its parallel path while recording, with std::sort's
-// result; outside a recording, the loops run on vtkSMPTools as before.
+// result; outside a recording, the loops run on vtkSMPTools as before; the chunked passes
+// (ForEachChunk, CountBefore, PlaceChunks) give the serial results on any number of threads.
 #include "rgmcCheck.h"
 #include "vtkRGParallel.h"
 #include "vtkRGSpan.h"
@@ -241,6 +242,79 @@ void TestCountBefore()
   RGMC_CHECK(none.size() == 1 && none[0] == 0, "no indices: one entry, 0");
 }
 
+/// PlaceChunks: outputs filled at the places it gives, each chunk's elements at At(c, d)
+/// onwards, equal the serial appends in index order after each output's start (outputs that
+/// start full, outputs nothing goes to), End the outputs' sizes; on 1, 2, 16 and 64 threads and
+/// while recording; no elements: End the starts.
+void TestPlaceChunks()
+{
+  std::mt19937_64 random(13);
+  const std::size_t outputs = 7;
+  std::vector<std::size_t> to(100003);
+  for (auto& d : to)
+  {
+    d = random() % (outputs - 1); // the last output gets nothing
+  }
+  const std::vector<std::size_t> start = { 0, 5, 0, 0, 17, 0, 3 };
+  std::vector<std::vector<vtkIdType>> serial(outputs);
+  for (std::size_t d = 0; d < outputs; ++d)
+  {
+    serial[d].assign(start[d], -1);
+  }
+  for (std::size_t i = 0; i < to.size(); ++i)
+  {
+    serial[to[i]].push_back(static_cast<vtkIdType>(i));
+  }
+  const vtkIdType n = static_cast<vtkIdType>(to.size()), chunk = 4096;
+  auto fill = [&]()
+  {
+    rgmc::ChunkPlaces places = rgmc::PlaceChunks(n, chunk, start,
+      [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
+      {
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          ++counts[to[static_cast<std::size_t>(i)]];
+        }
+      });
+    std::vector<std::vector<vtkIdType>> filled(outputs);
+    for (std::size_t d = 0; d < outputs; ++d)
+    {
+      filled[d].assign(places.End[d], -1);
+    }
+    rgmc::ForEachChunk(n, chunk,
+      [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          const std::size_t d = to[static_cast<std::size_t>(i)];
+          filled[d][places.At(c, d)++] = i;
+        }
+      });
+    return filled;
+  };
+  for (int threads : { 1, 2, 16, 64, 0 })
+  {
+    std::vector<std::vector<vtkIdType>> filled;
+    if (threads > 0)
+    {
+      vtkSMPTools::LocalScope(
+        vtkSMPTools::Config{ threads, "STDThread", false }, [&]() { filled = fill(); });
+    }
+    else
+    {
+      rgmc::SpanRecorder recorder;
+      recorder.Start();
+      filled = fill();
+      recorder.Stop();
+    }
+    RGMC_CHECK(filled == serial,
+      "PlaceChunks: the serial appends on " << threads << " threads (0: recording)");
+  }
+  const rgmc::ChunkPlaces none =
+    rgmc::PlaceChunks(0, chunk, start, [](vtkIdType, vtkIdType, vtkIdType, std::size_t*) {});
+  RGMC_CHECK(none.Places.empty() && none.End == start, "no elements: the outputs as they were");
+}
+
 /// ForEachChunk: every chunk once with c = begin / chunk, [begin, end) its own indices (the last
 /// chunk short), every index in exactly one chunk, on 1, 2, 16 and 64 threads and while
 /// recording; nothing for an empty range.
@@ -302,6 +376,7 @@ int main()
   TestPrefixAndExceptions();
   TestSortAndThreads();
   TestCountBefore();
+  TestPlaceChunks();
   TestForEachChunk();
   return rgmc_test::Result("TestSpanProfile");
 }
