@@ -184,6 +184,14 @@ void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
   const std::vector<std::array<RadixCounts, 8>> all =
     RadixHistograms(values, keyOf, parallel, ranges);
   Vector buffer(n);
+  // First touched range by range: a scatter's first range writes into every digit's part of
+  // the buffer, and so would fault in all its (huge) pages in one task.
+  parallel(static_cast<std::int64_t>(ranges.Count),
+    [&](std::int64_t r)
+    {
+      std::fill(buffer.begin() + ranges.Begin(r), buffer.begin() + ranges.End(r),
+        typename Vector::value_type());
+    });
   Vector* from = &values;
   Vector* to = &buffer;
   std::vector<RadixCounts> place(ranges.Count);
