@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -101,19 +103,15 @@ inline void WriteTriangles(
     });
 }
 
-/// Reads what WriteTriangles wrote: each triangle appended to its block's own or halo list
-/// (`blocks`, this rank's, by increasing id; a block this rank does not own is an error), the
-/// vertex records to `table`. On threads: each chunk of triangles finds their blocks and counts
-/// them per block, which gives each chunk its places in the blocks' lists (in message order, as
-/// a serial read would append them); the records go to their places.
-inline void ReadTriangles(
-  const std::vector<vtkIdType>& words, std::vector<Block>& blocks, VertexTable& table)
+/// Appends triangles [0, n) to their blocks' lists in order of t (`blocks`, this rank's, by
+/// increasing id; a block this rank does not own is an error): the first `own` to the block's
+/// own list, the others to its halo. blockOf(t) is triangle t's block id, cornersOf(t) its
+/// vertices' ids. On threads: each chunk of triangles finds their blocks and counts them per
+/// list, which gives each chunk its places in the lists (PlaceChunks); then they are filled.
+template <typename BlockOf, typename CornersOf>
+void AppendTriangles(
+  vtkIdType n, vtkIdType own, BlockOf&& blockOf, CornersOf&& cornersOf, std::vector<Block>& blocks)
 {
-  if (words.size() < 2)
-  {
-    return;
-  }
-  const vtkIdType own = words[0], n = words[0] + words[1];
   // At most 64 chunks (any cut gives the same lists): counts per chunk and block list.
   const vtkIdType chunk = std::max(rgmc::ElementChunk, rgmc::ChunksOf(n, 64));
   auto list = [&blocks](std::size_t l) -> std::vector<Triangle>&
@@ -129,7 +127,7 @@ inline void ReadTriangles(
     {
       for (vtkIdType t = begin; t < end; ++t)
       {
-        const vtkIdType id = words[2 + 4 * t];
+        const vtkIdType id = blockOf(t);
         const auto block = std::lower_bound(blocks.begin(), blocks.end(), id,
           [](const Block& b, vtkIdType key) { return b.Id < key; });
         if (block == blocks.end() || block->Id != id)
@@ -153,10 +151,29 @@ inline void ReadTriangles(
     {
       for (vtkIdType t = begin; t < end; ++t)
       {
-        const vtkIdType* w = words.data() + 2 + 4 * t;
-        list(listOf[t])[places.At(c, listOf[t])++] = { w[1], w[2], w[3] };
+        list(listOf[t])[places.At(c, listOf[t])++] = cornersOf(t);
       }
     });
+}
+
+/// Reads what WriteTriangles wrote: each triangle appended to its block's own or halo list
+/// (AppendTriangles), the vertex records to `table`, on threads.
+inline void ReadTriangles(
+  const std::vector<vtkIdType>& words, std::vector<Block>& blocks, VertexTable& table)
+{
+  if (words.size() < 2)
+  {
+    return;
+  }
+  const vtkIdType own = words[0], n = words[0] + words[1];
+  AppendTriangles(
+    n, own, [&words](vtkIdType t) { return words[2 + 4 * t]; },
+    [&words](vtkIdType t)
+    {
+      const vtkIdType* w = words.data() + 2 + 4 * t;
+      return Triangle{ w[1], w[2], w[3] };
+    },
+    blocks);
   const std::size_t start = 2 + 4 * static_cast<std::size_t>(n), size = table.Words();
   const std::size_t first = table.Vertices.size(), records = (words.size() - start) / size;
   table.Grow(records);
@@ -168,6 +185,84 @@ inline void ReadTriangles(
         table.ReadAt(first + i, words.data() + start + size * i);
       }
     });
+}
+
+/// What ReadTriangles reads from the message WriteTriangles writes of `staying` (this rank's
+/// triangles for its own blocks; put in the message's order here), taken from the part with no
+/// message: the same lists and the same records, on threads. The records are sorted by id as
+/// the message's are (a packed radix sort of the used vertices), so that the table's sort, once
+/// every message is read, finds them in place.
+inline void KeepTriangles(std::vector<Sending>& staying, const SurfacePart& part,
+  std::vector<Block>& blocks, VertexTable& table)
+{
+  std::stable_partition(staying.begin(), staying.end(), [](const Sending& s) { return s[2] == 0; });
+  const vtkIdType n = static_cast<vtkIdType>(staying.size());
+  const vtkIdType own =
+    std::count_if(staying.begin(), staying.end(), [](const Sending& s) { return s[2] == 0; });
+  auto corners = [&](vtkIdType t, vtkIdType c[3])
+  { part.Corners(static_cast<std::size_t>(staying[t][1]), c); };
+  AppendTriangles(
+    n, own, [&staying](vtkIdType t) { return staying[t][0]; },
+    [&](vtkIdType t)
+    {
+      vtkIdType c[3];
+      corners(t, c);
+      return Triangle{ part.Id(c[0]), part.Id(c[1]), part.Id(c[2]) };
+    },
+    blocks);
+  const vtkIdType nv = static_cast<vtkIdType>(part.NumberOfVertices());
+  std::vector<std::atomic<std::uint8_t>> used(static_cast<std::size_t>(nv));
+  rgmc::ForEachChunk(n, rgmc::ElementChunk,
+    [&](vtkIdType, vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType t = begin; t < end; ++t)
+      {
+        vtkIdType c[3];
+        corners(t, c);
+        for (vtkIdType v : c)
+        {
+          used[v].store(1, std::memory_order_relaxed);
+        }
+      }
+    });
+  auto isUsed = [&used](vtkIdType v) { return used[v].load(std::memory_order_relaxed) != 0; };
+  const std::vector<std::size_t> before = rgmc::CountBefore(nv, rgmc::ElementChunk, isUsed);
+  rgmc::OverwriteVector<vtkIdType> usedList(before.back()); // in the part's order
+  rgmc::ForEachChunk(nv, rgmc::ElementChunk,
+    [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+    {
+      std::size_t at = before[static_cast<std::size_t>(c)];
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        if (isUsed(v))
+        {
+          usedList[at++] = v;
+        }
+      }
+    });
+  const std::size_t first = table.Vertices.size(), records = usedList.size();
+  table.Grow(records);
+  auto put = [&](std::size_t at, vtkIdType v)
+  {
+    vtkIdType words[14]; // as the message would carry the vertex
+    part.Write(v, words);
+    table.ReadAt(first + at, words);
+  };
+  // By id, as in the message, so that the table's sort finds them in place (ids that do not
+  // fit the packed sort, negative ones, stay in the part's order: the sort moves them).
+  if (!rgmc::RadixSortPacked(
+        records, [&](std::size_t i) { return static_cast<std::uint64_t>(part.Id(usedList[i])); },
+        [&](std::size_t at, std::uint64_t, std::size_t i) { put(at, usedList[i]); }, rgmc::Tasks()))
+  {
+    rgmc::ForEachChunk(static_cast<vtkIdType>(records), rgmc::ElementChunk,
+      [&](vtkIdType, vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          put(static_cast<std::size_t>(i), usedList[i]);
+        }
+      });
+  }
 }
 
 } // namespace decimate

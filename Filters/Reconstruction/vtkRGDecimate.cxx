@@ -112,8 +112,9 @@ struct vtkRGDecimate::Run
   // SharedBlocks[SharedFirst[v]] to SharedBlocks[SharedFirst[v + 1] - 1] (none for the others).
   std::vector<std::uint32_t> SharedFirst;
   std::vector<std::int32_t> SharedBlocks;
-  std::vector<Block> Blocks; // this rank's, by increasing id, so by wave
-  vtkIdType Collapses = 0;   // made in the last pass, over all ranks
+  std::vector<Block> Blocks;    // this rank's, by increasing id, so by wave
+  std::vector<Sending> Staying; // the wave's triangles for this rank's own blocks: no message
+  vtkIdType Collapses = 0;      // made in the last pass, over all ranks
   int Passes = 0;
   double MaximumLevel = 0; // the largest quadric error kept, over all ranks
 
@@ -598,21 +599,33 @@ void vtkRGDecimate::SendTrianglesToBlocks(Run& run, int wave, Messages& outgoing
   }
   for (int r = 0; r < size; ++r)
   {
+    if (r == run.Ranks.Rank)
+    {
+      run.Staying = std::move(going[r]); // read from the part by AssembleBlocks
+      continue;
+    }
     WriteTriangles(outgoing[r], going[r], part);
     std::vector<Sending>().swap(going[r]);
   }
 }
 
 //------------------------------------------------------------------------------
-// The triangles received made into the wave's blocks' meshes (threads over blocks).
+// The triangles received, and this rank's own for its blocks, made into the wave's blocks'
+// meshes (threads over blocks).
 void vtkRGDecimate::AssembleBlocks(Run& run, int wave, Messages& incoming)
 {
   VertexTable seen; // the vertices of the wave's blocks' triangles
   seen.HasQuadrics = run.Part.HasQuadrics();
-  for (auto& words : incoming)
+  for (int r = 0; r < run.Ranks.Size; ++r) // in rank order, as the blocks' lists must be
   {
-    ReadTriangles(words, run.Blocks, seen);
-    std::vector<vtkIdType>().swap(words); // read: its memory goes back at once
+    if (r == run.Ranks.Rank)
+    {
+      KeepTriangles(run.Staying, run.Part, run.Blocks, seen);
+      std::vector<Sending>().swap(run.Staying);
+      continue;
+    }
+    ReadTriangles(incoming[r], run.Blocks, seen);
+    std::vector<vtkIdType>().swap(incoming[r]); // read: its memory goes back at once
   }
   seen.SortDistinct();
   // Area-weighted unless an error bound is asked for: see MaximumError.

@@ -2,7 +2,8 @@
 // (rgmcDecimateShared.h, rgmcDecimateMessages.h) against plain serial versions of the same
 // rules, on 1, 2, 16 and 64 threads: the records each rank is sent (as a set, to the rank of the
 // vertex's id), the answers (to the word, in order), the blocks' lists and vertex records read
-// from a message (in message order, after what the lists held). The surfaces are
+// from a message (in message order, after what the lists held), and the same read from the
+// rank's own part with no message (KeepTriangles) against the message. The surfaces are
 // large enough for many chunks, so vertices whose triangles or records straddle a chunk's end
 // are met.
 #include "rgmcCheck.h"
@@ -297,6 +298,113 @@ void TestReadTriangles()
   RGMC_CHECK(refused, "a triangle for a block not owned is an error");
 }
 
+/// Blocks 10, 20, ..., 10 * count, their lists holding what a first message brought.
+std::vector<rgmc::decimate::Block> BlocksAfterAMessage(std::mt19937_64 random, int count)
+{
+  std::vector<rgmc::decimate::Block> blocks(static_cast<std::size_t>(count));
+  for (int b = 0; b < count; ++b)
+  {
+    blocks[b].Id = 10 * (b + 1);
+  }
+  rgmc::decimate::VertexTable none;
+  rgmc::decimate::ReadTriangles(Message(random, 3000, 1000, 0, false, count), blocks, none);
+  return blocks;
+}
+
+/// KeepTriangles against the message it stands for, ReadTriangles(WriteTriangles(...)): the
+/// blocks' lists (after what they held) and the records, word for word and in the same order
+/// (by id) for a part read from the input and for one of its own with quadrics; with negative
+/// ids (which the packed sort cannot take) the same records once the table is sorted. On 1, 2,
+/// 16 and 64 threads.
+void TestKeepTriangles()
+{
+  using rgmc::decimate::Sending;
+  std::mt19937_64 random(17);
+  const int count = 40;
+  for (int flavour : { 0, 1, 2 }) // the input; negative ids; the part's own, with quadrics
+  {
+    Soup soup(150000, 250000, random);
+    auto* ids = vtkIdTypeArray::SafeDownCast(soup.Mesh->GetPointData()->GetGlobalIds());
+    for (vtkIdType v = 0; flavour == 1 && v < ids->GetNumberOfValues(); ++v)
+    {
+      ids->SetValue(v, -ids->GetValue(v));
+    }
+    rgmc::decimate::SurfacePart part;
+    part.Read(soup.Mesh);
+    if (flavour == 2)
+    {
+      part.OwnInput();
+      part.Vertices.HasQuadrics = true;
+      part.Vertices.Quadrics.resize(part.Vertices.Vertices.size());
+      for (auto& q : part.Vertices.Quadrics)
+      {
+        for (double& term : q.Terms)
+        {
+          term = static_cast<double>(random() % 100000) / 7.0;
+        }
+      }
+    }
+    // As SendTrianglesToBlocks lists them: by triangle, its own block and some halos.
+    std::vector<Sending> staying;
+    for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
+    {
+      const vtkIdType own = 10 * (1 + soup.Blocks[t]);
+      if (random() % 3 != 0)
+      {
+        staying.push_back({ own, static_cast<vtkIdType>(t), 0 });
+      }
+      if (random() % 10 == 0)
+      {
+        staying.push_back(
+          { 10 * (1 + static_cast<vtkIdType>(random() % count)), static_cast<vtkIdType>(t), 1 });
+      }
+    }
+    const std::mt19937_64 first = random;
+    std::vector<rgmc::decimate::Block> expected = BlocksAfterAMessage(first, count);
+    rgmc::decimate::VertexTable expectedTable;
+    expectedTable.HasQuadrics = part.HasQuadrics();
+    std::vector<Sending> going = staying;
+    std::vector<vtkIdType> words;
+    rgmc::decimate::WriteTriangles(words, going, part);
+    rgmc::decimate::ReadTriangles(words, expected, expectedTable);
+    if (flavour == 1)
+    {
+      expectedTable.SortDistinct();
+    }
+    for (int threads : { 1, 2, 16, 64 })
+    {
+      std::vector<rgmc::decimate::Block> kept = BlocksAfterAMessage(first, count);
+      rgmc::decimate::VertexTable table;
+      table.HasQuadrics = part.HasQuadrics();
+      std::vector<Sending> copy = staying;
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]() { rgmc::decimate::KeepTriangles(copy, part, kept, table); });
+      if (flavour == 1)
+      {
+        table.SortDistinct();
+      }
+      bool lists = true;
+      for (int b = 0; lists && b < count; ++b)
+      {
+        lists = kept[b].Own == expected[b].Own && kept[b].Halo == expected[b].Halo;
+      }
+      RGMC_CHECK(lists,
+        "the lists kept equal the message's, flavour " << flavour << ", " << threads << " threads");
+      bool records = table.Vertices.size() == expectedTable.Vertices.size();
+      std::vector<vtkIdType> a(table.Words()), b(table.Words());
+      for (std::size_t i = 0; records && i < table.Vertices.size(); ++i)
+      {
+        table.Write(i, a.data());
+        expectedTable.Write(i, b.data());
+        records = a == b;
+      }
+      RGMC_CHECK(records,
+        "the records kept equal the message's, flavour " << flavour << ", " << threads
+                                                         << " threads");
+    }
+  }
+}
+
 } // namespace
 
 int main()
@@ -304,5 +412,6 @@ int main()
   TestVertexBlocks();
   TestAnswers();
   TestReadTriangles();
+  TestKeepTriangles();
   return rgmc_test::Result("TestDecimateShared");
 }
