@@ -35,12 +35,13 @@ inline std::vector<bool> Everyone(int size)
 
 /// A triangle of this rank's part going to a block: (block, triangle, 1 if to its halo).
 using Sending = std::array<vtkIdType, 3>;
+/// The triangles going to one rank (sized, then written whole on threads).
+using Sendings = rgmc::OverwriteVector<Sending>;
 
 /// A message of triangles for blocks: the counts of own and halo triangles, (block, three
 /// vertex ids) for each (the own ones first), then the records of their vertices, each once, by
 /// increasing id. Written in fixed chunks on threads (each part of the message has its place).
-inline void WriteTriangles(
-  std::vector<vtkIdType>& words, std::vector<Sending>& going, const SurfacePart& part)
+inline void WriteTriangles(std::vector<vtkIdType>& words, Sendings& going, const SurfacePart& part)
 {
   std::stable_partition(going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; });
   const auto halos =
@@ -192,8 +193,8 @@ inline void ReadTriangles(
 /// message: the same lists and the same records, on threads. The records are sorted by id as
 /// the message's are (a packed radix sort of the used vertices), so that the table's sort, once
 /// every message is read, finds them in place.
-inline void KeepTriangles(std::vector<Sending>& staying, const SurfacePart& part,
-  std::vector<Block>& blocks, VertexTable& table)
+inline void KeepTriangles(
+  Sendings& staying, const SurfacePart& part, std::vector<Block>& blocks, VertexTable& table)
 {
   std::stable_partition(staying.begin(), staying.end(), [](const Sending& s) { return s[2] == 0; });
   const vtkIdType n = static_cast<vtkIdType>(staying.size());

@@ -112,9 +112,9 @@ struct vtkRGDecimate::Run
   // SharedBlocks[SharedFirst[v]] to SharedBlocks[SharedFirst[v + 1] - 1] (none for the others).
   std::vector<std::uint32_t> SharedFirst;
   std::vector<std::int32_t> SharedBlocks;
-  std::vector<Block> Blocks;    // this rank's, by increasing id, so by wave
-  std::vector<Sending> Staying; // the wave's triangles for this rank's own blocks: no message
-  vtkIdType Collapses = 0;      // made in the last pass, over all ranks
+  std::vector<Block> Blocks;   // this rank's, by increasing id, so by wave
+  std::vector<Sendings> Going; // per rank: the wave's triangles for its blocks (ListSendings)
+  vtkIdType Collapses = 0;     // made in the last pass, over all ranks
   int Passes = 0;
   double MaximumLevel = 0; // the largest quadric error kept, over all ranks
 
@@ -557,55 +557,88 @@ bool vtkRGDecimate::SendTriangles(Run& run, int wave)
 }
 
 //------------------------------------------------------------------------------
-// The messages of the part's triangles to the ranks of the wave's blocks: each to its own
-// block, and to the other blocks of its vertices as their halo.
+// The part's triangles for the wave's blocks, per rank of the block: to its own block, and to
+// the other blocks of its vertices as their halo (the own ones first, each kind in order of
+// triangle and, for a triangle's halos, of block). On threads: each chunk of triangles lists its
+// sendings per rank and kind; they are then copied to their places (PlaceChunks).
+void vtkRGDecimate::ListSendings(Run& run, int wave)
+{
+  const std::size_t size = static_cast<std::size_t>(run.Ranks.Size), kinds = 2 * size;
+  const SurfacePart& part = run.Part;
+  const vtkIdType n = static_cast<vtkIdType>(part.NumberOfTriangles());
+  std::vector<Sendings> found( // per chunk and kind: 2r own triangles of rank r, 2r + 1 halos
+    static_cast<std::size_t>(rgmc::ChunksOf(n, rgmc::ElementChunk)) * kinds);
+  rgmc::ChunkPlaces places =
+    rgmc::PlaceChunks(n, rgmc::ElementChunk, std::vector<std::size_t>(kinds, 0),
+      [&](vtkIdType chunk, vtkIdType begin, vtkIdType end, std::size_t* counts)
+      {
+        Sendings* lists = found.data() + static_cast<std::size_t>(chunk) * kinds;
+        std::vector<vtkIdType> others;
+        for (vtkIdType t = begin; t < end; ++t)
+        {
+          const vtkIdType block = run.PartBlock[t];
+          if (run.WaveOf[block] == wave)
+          {
+            lists[2 * run.Owner[block]].push_back({ block, t, 0 });
+          }
+          vtkIdType c[3];
+          part.Corners(static_cast<std::size_t>(t), c);
+          others.clear();
+          for (vtkIdType v : c)
+          {
+            for (std::uint32_t i = run.SharedFirst[v]; i < run.SharedFirst[v + 1]; ++i)
+            {
+              const vtkIdType other = run.SharedBlocks[i];
+              if (other != block && run.WaveOf[other] == wave)
+              {
+                others.push_back(other);
+              }
+            }
+          }
+          std::sort(others.begin(), others.end());
+          others.erase(std::unique(others.begin(), others.end()), others.end());
+          for (vtkIdType other : others)
+          {
+            lists[2 * run.Owner[other] + 1].push_back({ other, t, 1 });
+          }
+        }
+        for (std::size_t k = 0; k < kinds; ++k)
+        {
+          counts[k] = lists[k].size();
+        }
+      });
+  std::vector<Sendings>& going = run.Going;
+  going.assign(size, Sendings());
+  for (std::size_t r = 0; r < size; ++r)
+  {
+    going[r].resize(places.End[2 * r] + places.End[2 * r + 1]);
+  }
+  rgmc::ForEachChunk(n, rgmc::ElementChunk,
+    [&](vtkIdType chunk, vtkIdType, vtkIdType)
+    {
+      for (std::size_t k = 0; k < kinds; ++k)
+      {
+        Sendings& list = found[static_cast<std::size_t>(chunk) * kinds + k];
+        const std::size_t at = places.At(chunk, k) + (k % 2 ? places.End[k - 1] : 0);
+        std::copy(list.begin(), list.end(), going[k / 2].begin() + at);
+        Sendings().swap(list);
+      }
+    });
+}
+
+//------------------------------------------------------------------------------
+// The messages of the part's triangles to the ranks of the wave's blocks (ListSendings); what
+// goes to this rank's own blocks stays in run.Going for AssembleBlocks, with no message.
 void vtkRGDecimate::SendTrianglesToBlocks(Run& run, int wave, Messages& outgoing)
 {
-  const int size = run.Ranks.Size;
-  const SurfacePart& part = run.Part;
-  std::vector<std::vector<Sending>> going(static_cast<std::size_t>(size));
-  std::vector<vtkIdType> others;
-  for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
+  this->ListSendings(run, wave);
+  for (int r = 0; r < run.Ranks.Size; ++r)
   {
-    const vtkIdType block = run.PartBlock[t];
-    if (run.WaveOf[block] == wave)
+    if (r != run.Ranks.Rank)
     {
-      going[run.Owner[block]].push_back({ block, static_cast<vtkIdType>(t), 0 });
+      WriteTriangles(outgoing[r], run.Going[r], run.Part);
+      Sendings().swap(run.Going[r]);
     }
-    vtkIdType c[3];
-    part.Corners(t, c);
-    others.clear();
-    for (vtkIdType v : c)
-    {
-      for (std::uint32_t i = run.SharedFirst[v]; i < run.SharedFirst[v + 1]; ++i)
-      {
-        const vtkIdType other = run.SharedBlocks[i];
-        if (other != block && run.WaveOf[other] == wave)
-        {
-          others.push_back(other);
-        }
-      }
-    }
-    if (others.empty())
-    {
-      continue;
-    }
-    std::sort(others.begin(), others.end());
-    others.erase(std::unique(others.begin(), others.end()), others.end());
-    for (vtkIdType other : others)
-    {
-      going[run.Owner[other]].push_back({ other, static_cast<vtkIdType>(t), 1 });
-    }
-  }
-  for (int r = 0; r < size; ++r)
-  {
-    if (r == run.Ranks.Rank)
-    {
-      run.Staying = std::move(going[r]); // read from the part by AssembleBlocks
-      continue;
-    }
-    WriteTriangles(outgoing[r], going[r], part);
-    std::vector<Sending>().swap(going[r]);
   }
 }
 
@@ -620,8 +653,8 @@ void vtkRGDecimate::AssembleBlocks(Run& run, int wave, Messages& incoming)
   {
     if (r == run.Ranks.Rank)
     {
-      KeepTriangles(run.Staying, run.Part, run.Blocks, seen);
-      std::vector<Sending>().swap(run.Staying);
+      KeepTriangles(run.Going[r], run.Part, run.Blocks, seen);
+      Sendings().swap(run.Going[r]);
       continue;
     }
     ReadTriangles(incoming[r], run.Blocks, seen);

@@ -345,7 +345,7 @@ void TestKeepTriangles()
       }
     }
     // As SendTrianglesToBlocks lists them: by triangle, its own block and some halos.
-    std::vector<Sending> staying;
+    rgmc::decimate::Sendings staying;
     for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
     {
       const vtkIdType own = 10 * (1 + soup.Blocks[t]);
@@ -363,7 +363,7 @@ void TestKeepTriangles()
     std::vector<rgmc::decimate::Block> expected = BlocksAfterAMessage(first, count);
     rgmc::decimate::VertexTable expectedTable;
     expectedTable.HasQuadrics = part.HasQuadrics();
-    std::vector<Sending> going = staying;
+    rgmc::decimate::Sendings going = staying;
     std::vector<vtkIdType> words;
     rgmc::decimate::WriteTriangles(words, going, part);
     rgmc::decimate::ReadTriangles(words, expected, expectedTable);
@@ -376,7 +376,7 @@ void TestKeepTriangles()
       std::vector<rgmc::decimate::Block> kept = BlocksAfterAMessage(first, count);
       rgmc::decimate::VertexTable table;
       table.HasQuadrics = part.HasQuadrics();
-      std::vector<Sending> copy = staying;
+      rgmc::decimate::Sendings copy = staying;
       vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
         [&]() { rgmc::decimate::KeepTriangles(copy, part, kept, table); });
       if (flavour == 1)
