@@ -50,8 +50,8 @@ constexpr int DistancePointsTag = 7411, DistanceTrianglesTag = 7413, DistanceCel
 /// One surface's part on this rank: its owned vertices and its triangles (canonical corners).
 struct DistanceSurface
 {
-  std::vector<double> Points;    // 3 a vertex, each global vertex on one rank only
-  std::vector<double> Triangles; // 9 a triangle
+  OverwriteVector<double> Points;    // 3 a vertex, each global vertex on one rank only
+  OverwriteVector<double> Triangles; // 9 a triangle (both sized, then filled on threads)
   double Lo[3] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
     std::numeric_limits<double>::max() };
   double Hi[3] = { -std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
@@ -234,8 +234,9 @@ struct DistanceCells
 
 /// Measures the vertices `points` (at their cell's rank already) against `triangles`, within
 /// `limit`: adds the resolved ones to `into`, returns the others' coordinates.
-inline std::vector<double> MeasureWithin(const std::vector<double>& points,
-  const std::vector<double>& triangles, double bucket, double limit, DirectedDistance& into)
+template <typename Points, typename Triangles> // contiguous containers of doubles
+std::vector<double> MeasureWithin(const Points& points, const Triangles& triangles, double bucket,
+  double limit, DirectedDistance& into)
 {
   SpanMark("distance: buckets");
   const TriangleBuckets buckets(triangles, bucket, Tasks());

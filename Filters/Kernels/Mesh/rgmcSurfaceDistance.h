@@ -131,12 +131,14 @@ inline void CanonicalTriangle(double t[9])
 class TriangleBuckets
 {
 public:
-  /// `corners`: 9 coordinates a triangle, kept by reference; `size`: the buckets' edge.
-  template <typename Parallel = SerialTasks>
-  TriangleBuckets(const std::vector<double>& corners, double size, Parallel&& parallel = Parallel())
-    : Corners(corners)
+  /// `corners`: 9 coordinates a triangle (a contiguous container of doubles: a std::vector with
+  /// any allocator), kept by reference; `size`: the buckets' edge.
+  template <typename Container, typename Parallel = SerialTasks>
+  TriangleBuckets(const Container& corners, double size, Parallel&& parallel = Parallel())
+    : Corners(corners.data())
+    , Triangles(corners.size() / 9)
   {
-    this->Build(corners.size() / 9, size, parallel);
+    this->Build(this->Triangles, size, parallel);
   }
 
   /// The smallest squared distance from p to a triangle, searching the buckets within `limit`
@@ -217,7 +219,7 @@ private:
     }
     if (keyBits + triangleBits <= 64)
     {
-      LargeVector<std::uint64_t> words(first.back());
+      OverwriteVector<std::uint64_t> words(first.back()); // filled whole by Pairs
       this->Pairs(first, parallel,
         [&](std::size_t at, std::int64_t key, std::size_t t)
         { words[at] = static_cast<std::uint64_t>(key) << triangleBits | t; });
@@ -317,14 +319,36 @@ private:
           this->Items[i] = triangleAt(i);
         }
       });
-    this->Start.clear();
-    for (std::size_t i = 0; i < pairs; ++i)
-    {
-      if (i == 0 || keyAt(i) != keyAt(i - 1))
+    // Each bucket's first pair: counted per range, then written at the range's place.
+    auto starts = [&keyAt](std::size_t i) { return i == 0 || keyAt(i) != keyAt(i - 1); };
+    std::vector<std::size_t> before(static_cast<std::size_t>(ranges) + 1, 0);
+    parallel(ranges,
+      [&](std::int64_t r)
       {
-        this->Start.push_back(i);
-      }
+        const std::size_t last = std::min(pairs, (static_cast<std::size_t>(r) + 1) * Chunk);
+        for (std::size_t i = static_cast<std::size_t>(r) * Chunk; i < last; ++i)
+        {
+          before[static_cast<std::size_t>(r) + 1] += starts(i);
+        }
+      });
+    for (std::size_t r = 0; r + 1 < before.size(); ++r)
+    {
+      before[r + 1] += before[r];
     }
+    this->Start.resize(before.back());
+    parallel(ranges,
+      [&](std::int64_t r)
+      {
+        std::size_t at = before[static_cast<std::size_t>(r)];
+        const std::size_t last = std::min(pairs, (static_cast<std::size_t>(r) + 1) * Chunk);
+        for (std::size_t i = static_cast<std::size_t>(r) * Chunk; i < last; ++i)
+        {
+          if (starts(i))
+          {
+            this->Start[at++] = i;
+          }
+        }
+      });
     this->Index = KeyMap(this->Start.size());
     for (std::size_t b = 0; b < this->Start.size(); ++b)
     {
@@ -338,10 +362,10 @@ private:
   template <typename F>
   void ForBuckets(std::size_t c, F&& f) const
   {
-    const std::size_t n = this->Corners.size() / 9;
+    const std::size_t n = this->Triangles;
     for (std::size_t t = c * Chunk; t < std::min(n, (c + 1) * Chunk); ++t)
     {
-      const double* p = this->Corners.data() + 9 * t;
+      const double* p = this->Corners + 9 * t;
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a)
       {
@@ -399,7 +423,7 @@ private:
           const std::size_t b = static_cast<std::size_t>(*found);
           for (std::uint64_t i = this->Start[b]; i < this->Start[b + 1]; ++i)
           {
-            const double* t = this->Corners.data() + 9 * std::size_t(this->Items[i]);
+            const double* t = this->Corners + 9 * std::size_t(this->Items[i]);
             best = std::min(best, PointTriangleDistance2(p, t, t + 3, t + 6));
           }
         }
@@ -407,7 +431,8 @@ private:
     }
   }
 
-  const std::vector<double>& Corners;
+  const double* Corners;
+  std::size_t Triangles;
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
   int Dims[3] = { 1, 1, 1 };
