@@ -2,7 +2,7 @@
 // come out as std::sort on the pairs gives them, for keys that differ in few or many bytes, with
 // many equal keys, and for keys whose top bits are set (unsigned order); the packed sort runs
 // exactly when every key fits above the indices' bits; on tasks (ranges of 65 536 values) run
-// in reverse order and on threads, the same.
+// in reverse order and on threads, the same, in a vector that leaves new values unset too.
 #include "rgmcCheck.h"
 #include "rgmcRadixSort.h"
 #include "rgmcTaskOrders.h"
@@ -59,6 +59,16 @@ void Check(const std::vector<std::uint64_t>& keys, const char* what)
     rgmc::RadixSort(
       onTasks, [](const Record& r) { return r.first; }, parallel);
     RGMC_CHECK(onTasks == expected, what << ", " << how << ": " << keys.size() << " keys");
+    // A vector that leaves its values unset (its buffer then first touched range by range).
+    rgmc::OverwriteVector<Record> unset(onTasks.size());
+    for (std::size_t i = 0; i < keys.size(); ++i)
+    {
+      unset[i] = Record(keys[i], static_cast<std::int64_t>(i));
+    }
+    rgmc::RadixSort(
+      unset, [](const Record& r) { return r.first; }, parallel);
+    RGMC_CHECK(std::equal(unset.begin(), unset.end(), expected.begin(), expected.end()),
+      what << ", " << how << ", unset buffer: " << keys.size() << " keys");
     std::vector<Record> packedOnTasks(keys.size(), Record(0, -1));
     const bool doneOnTasks = rgmc::RadixSortPacked(
       keys.size(), [&keys](std::size_t i) { return keys[i]; },
@@ -69,6 +79,11 @@ void Check(const std::vector<std::uint64_t>& keys, const char* what)
       what << ", " << how << ": " << keys.size() << " keys, packed");
   }
 }
+
+static_assert(rgmc::LeavesValuesUnset<rgmc::OverwriteVector<Record>>::value &&
+    !rgmc::LeavesValuesUnset<rgmc::LargeVector<Record>>::value &&
+    !rgmc::LeavesValuesUnset<std::vector<Record>>::value,
+  "only an OverwriteVector leaves its values unset");
 
 } // namespace
 

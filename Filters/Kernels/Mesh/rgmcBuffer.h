@@ -183,6 +183,17 @@ struct OverwriteAllocator : LargeArrayAllocator<T>
 template <typename T>
 using OverwriteVector = std::vector<T, OverwriteAllocator<T>>;
 
+/// True for a vector whose allocator leaves new values unset (OverwriteVector): one that
+/// `vector(n)` hands over untouched, for its first writer to fault in.
+template <typename Vector>
+struct LeavesValuesUnset : std::false_type
+{
+};
+template <typename T>
+struct LeavesValuesUnset<std::vector<T, OverwriteAllocator<T>>> : std::true_type
+{
+};
+
 template <typename T>
 class Buffer
 {

@@ -184,14 +184,18 @@ void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
   const std::vector<std::array<RadixCounts, 8>> all =
     RadixHistograms(values, keyOf, parallel, ranges);
   Vector buffer(n);
-  // First touched range by range: a scatter's first range writes into every digit's part of
-  // the buffer, and so would fault in all its (huge) pages in one task.
-  parallel(static_cast<std::int64_t>(ranges.Count),
-    [&](std::int64_t r)
-    {
-      std::fill(buffer.begin() + ranges.Begin(r), buffer.begin() + ranges.End(r),
-        typename Vector::value_type());
-    });
+  // An unset buffer (OverwriteVector) first touched range by range: a scatter's first range
+  // writes into every digit's part of it, and so would fault in all its (huge) pages in one
+  // task. Other vectors come zeroed, their pages touched already.
+  if (LeavesValuesUnset<Vector>::value)
+  {
+    parallel(static_cast<std::int64_t>(ranges.Count),
+      [&](std::int64_t r)
+      {
+        std::fill(buffer.begin() + ranges.Begin(r), buffer.begin() + ranges.End(r),
+          typename Vector::value_type());
+      });
+  }
   Vector* from = &values;
   Vector* to = &buffer;
   std::vector<RadixCounts> place(ranges.Count);
@@ -243,7 +247,7 @@ bool RadixSortPacked(std::size_t n, KeyAt&& keyAt, Put&& put, Parallel&& paralle
     return false;
   }
   const std::uint64_t largestKey = ~std::uint64_t(0) >> indexBits;
-  LargeVector<std::uint64_t> packed(n);
+  OverwriteVector<std::uint64_t> packed(n); // written whole below
   const std::int64_t ranges = static_cast<std::int64_t>((n + RadixRange - 1) / RadixRange);
   std::vector<std::uint8_t> fits(static_cast<std::size_t>(ranges), 1);
   parallel(ranges,
