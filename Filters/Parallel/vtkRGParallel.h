@@ -5,6 +5,7 @@
 #ifndef vtkRGParallel_h
 #define vtkRGParallel_h
 
+#include "rgmcTasks.h"
 #include "vtkRGSpan.h"
 #include "vtkSMPTools.h"
 #include "vtkType.h"
@@ -74,12 +75,6 @@ void ParallelFor(vtkIdType count, vtkIdType grain, Body&& body)
 /// are the same on any number of threads.
 constexpr vtkIdType ElementChunk = 65536;
 
-/// How many chunks of `chunk` elements cover [0, n).
-inline vtkIdType ChunksOf(vtkIdType n, vtkIdType chunk)
-{
-  return (n + chunk - 1) / chunk;
-}
-
 /// body(c, begin, end) for every chunk c = [begin, end) of [0, n), `chunk` elements each but
 /// the last, on threads through ParallelFor, one chunk a task.
 template <typename Body>
@@ -93,62 +88,6 @@ void ForEachChunk(vtkIdType n, vtkIdType chunk, Body&& body)
         body(c, c * chunk, std::min(n, (c + 1) * chunk));
       }
     });
-}
-
-/// Where each chunk of [0, n) puts its elements in several outputs filled in chunk order (a
-/// rank's message, a block's list), so that every output is the same on any number of threads.
-/// At(c, d) is chunk c's first place in output d, End[d] the output's end once all are in.
-struct ChunkPlaces
-{
-  std::size_t Outputs = 0;
-  std::vector<std::size_t> Places; // Places[c * Outputs + d]
-  std::vector<std::size_t> End;
-
-  std::size_t& At(vtkIdType c, std::size_t d)
-  {
-    return this->Places[static_cast<std::size_t>(c) * this->Outputs + d];
-  }
-};
-
-/// count(c, begin, end, counts) adds to counts[d] how many elements of chunk c = [begin, end)
-/// go to output d (on threads, one chunk a task, counts zeroed); the counts are then summed in
-/// chunk order from start[d], output d's first place, so chunk c's elements in output d follow
-/// those of every chunk before it.
-template <typename Count>
-ChunkPlaces PlaceChunks(vtkIdType n, vtkIdType chunk, std::vector<std::size_t> start, Count&& count)
-{
-  ChunkPlaces places;
-  places.Outputs = start.size();
-  places.Places.assign(static_cast<std::size_t>(ChunksOf(n, chunk)) * places.Outputs, 0);
-  ForEachChunk(n, chunk,
-    [&](vtkIdType c, vtkIdType begin, vtkIdType end) { count(c, begin, end, &places.At(c, 0)); });
-  places.End = std::move(start);
-  for (std::size_t i = 0; i < places.Places.size(); i += places.Outputs)
-  {
-    for (std::size_t d = 0; d < places.Outputs; ++d)
-    {
-      places.End[d] += std::exchange(places.Places[i + d], places.End[d]);
-    }
-  }
-  return places;
-}
-
-/// before[c]: how many of the indices i < c * chunk, 0 <= i < n, have counted(i) true (a
-/// count per chunk on threads, then their sums in order); before has one entry per chunk and
-/// one more, the total.
-template <typename Counted>
-std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& counted)
-{
-  ChunkPlaces places = PlaceChunks(n, chunk, { 0 },
-    [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
-    {
-      for (vtkIdType i = begin; i < end; ++i)
-      {
-        counts[0] += counted(i);
-      }
-    });
-  places.Places.push_back(places.End[0]);
-  return std::move(places.Places);
 }
 
 /// The kernels' parallel(count, task) (rgmc::RadixSort's, for one): task(i) for every i in
@@ -168,6 +107,20 @@ struct Tasks
       });
   }
 };
+
+/// rgmc::PlaceChunks (rgmcTasks.h) on vtkSMPTools' threads, one chunk a task.
+template <typename Count>
+ChunkPlaces PlaceChunks(vtkIdType n, vtkIdType chunk, std::vector<std::size_t> start, Count&& count)
+{
+  return PlaceChunks(n, chunk, std::move(start), count, Tasks());
+}
+
+/// rgmc::CountBefore (rgmcTasks.h) on vtkSMPTools' threads, one chunk a task.
+template <typename Counted>
+std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& counted)
+{
+  return CountBefore(n, chunk, counted, Tasks());
+}
 
 /// Sorts [begin, end) on threads: fixed slices (not one per thread) sorted at once, then merged
 /// pairwise in rounds. The elements must be totally ordered (no two equal), so that the result

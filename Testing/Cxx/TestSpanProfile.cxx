@@ -6,6 +6,7 @@
 // result; outside a recording, the loops run on vtkSMPTools as before; the chunked passes
 // (ForEachChunk, CountBefore, PlaceChunks) give the serial results on any number of threads.
 #include "rgmcCheck.h"
+#include "rgmcTaskOrders.h"
 #include "vtkRGParallel.h"
 #include "vtkRGSpan.h"
 
@@ -244,8 +245,8 @@ void TestCountBefore()
 
 /// PlaceChunks: outputs filled at the places it gives, each chunk's elements at At(c, d)
 /// onwards, equal the serial appends in index order after each output's start (outputs that
-/// start full, outputs nothing goes to), End the outputs' sizes; on 1, 2, 16 and 64 threads and
-/// while recording; no elements: End the starts.
+/// start full, outputs nothing goes to), End the outputs' sizes; on 1, 2, 16 and 64 threads,
+/// while recording, and the kernels' on tasks in reverse order; no elements: End the starts.
 void TestPlaceChunks()
 {
   std::mt19937_64 random(13);
@@ -266,16 +267,19 @@ void TestPlaceChunks()
     serial[to[i]].push_back(static_cast<vtkIdType>(i));
   }
   const vtkIdType n = static_cast<vtkIdType>(to.size()), chunk = 4096;
-  auto fill = [&]()
+  auto count = [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
   {
-    rgmc::ChunkPlaces places = rgmc::PlaceChunks(n, chunk, start,
-      [&](vtkIdType, vtkIdType begin, vtkIdType end, std::size_t* counts)
-      {
-        for (vtkIdType i = begin; i < end; ++i)
-        {
-          ++counts[to[static_cast<std::size_t>(i)]];
-        }
-      });
+    for (vtkIdType i = begin; i < end; ++i)
+    {
+      ++counts[to[static_cast<std::size_t>(i)]];
+    }
+  };
+  // The kernels' PlaceChunks on tasks run in reverse order, or vtkRGParallel's on threads.
+  auto fill = [&](bool reversed = false)
+  {
+    rgmc::ChunkPlaces places = reversed
+      ? rgmc::PlaceChunks(n, chunk, start, count, rgmc_test::TasksReversed)
+      : rgmc::PlaceChunks(n, chunk, start, count);
     std::vector<std::vector<vtkIdType>> filled(outputs);
     for (std::size_t d = 0; d < outputs; ++d)
     {
@@ -292,13 +296,17 @@ void TestPlaceChunks()
       });
     return filled;
   };
-  for (int threads : { 1, 2, 16, 64, 0 })
+  for (int threads : { 1, 2, 16, 64, 0, -1 })
   {
     std::vector<std::vector<vtkIdType>> filled;
     if (threads > 0)
     {
       vtkSMPTools::LocalScope(
         vtkSMPTools::Config{ threads, "STDThread", false }, [&]() { filled = fill(); });
+    }
+    else if (threads < 0)
+    {
+      filled = fill(true);
     }
     else
     {
@@ -308,7 +316,8 @@ void TestPlaceChunks()
       recorder.Stop();
     }
     RGMC_CHECK(filled == serial,
-      "PlaceChunks: the serial appends on " << threads << " threads (0: recording)");
+      "PlaceChunks: the serial appends on " << threads
+                                            << " threads (0: recording, -1: tasks reversed)");
   }
   const rgmc::ChunkPlaces none =
     rgmc::PlaceChunks(0, chunk, start, [](vtkIdType, vtkIdType, vtkIdType, std::size_t*) {});

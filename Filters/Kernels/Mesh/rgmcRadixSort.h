@@ -4,6 +4,7 @@
 #define rgmcRadixSort_h
 
 #include "rgmcBuffer.h"
+#include "rgmcTasks.h"
 
 #include <algorithm>
 #include <array>
@@ -71,20 +72,6 @@ void RadixSort(Vector& values, KeyOf&& keyOf)
     values.swap(buffer);
   }
 }
-
-/// Runs task(i) for each i in [0, count), in order, on this thread: the default of the sorts'
-/// `parallel` argument.
-struct SerialTasks
-{
-  template <typename Task>
-  void operator()(std::int64_t count, Task&& task) const
-  {
-    for (std::int64_t i = 0; i < count; ++i)
-    {
-      task(i);
-    }
-  }
-};
 
 /// Values per task of the parallel sorts (fixed: the ranges never depend on the threads).
 constexpr std::size_t RadixRange = 65536;

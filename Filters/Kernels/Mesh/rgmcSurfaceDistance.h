@@ -191,19 +191,14 @@ private:
     const std::size_t chunks = (n + Chunk - 1) / Chunk;
     this->Place(n, chunks, size, parallel);
     // The pairs of each chunk after those of the chunks before it.
-    std::vector<std::size_t> first(chunks + 1, 0);
-    parallel(static_cast<std::int64_t>(chunks),
-      [&](std::int64_t c)
+    ChunkPlaces first = PlaceChunks(
+      static_cast<std::int64_t>(n), Chunk, { 0 },
+      [this](std::int64_t c, std::int64_t, std::int64_t, std::size_t* count)
       {
-        std::size_t count = 0;
         this->ForBuckets(
-          static_cast<std::size_t>(c), [&count](std::int64_t, std::size_t) { ++count; });
-        first[static_cast<std::size_t>(c) + 1] = count;
-      });
-    for (std::size_t c = 0; c < chunks; ++c)
-    {
-      first[c + 1] += first[c];
-    }
+          static_cast<std::size_t>(c), [count](std::int64_t, std::size_t) { ++*count; });
+      },
+      parallel);
     // A pair as one word (the bucket's key above the triangle's bits) where it fits, else as
     // two; sorted by key, stably, so each bucket's triangles stay in increasing order.
     int triangleBits = 1, keyBits = 1;
@@ -219,7 +214,7 @@ private:
     }
     if (keyBits + triangleBits <= 64)
     {
-      OverwriteVector<std::uint64_t> words(first.back()); // filled whole by Pairs
+      OverwriteVector<std::uint64_t> words(first.End[0]); // filled whole by Pairs
       this->Pairs(first, parallel,
         [&](std::size_t at, std::int64_t key, std::size_t t)
         { words[at] = static_cast<std::uint64_t>(key) << triangleBits | t; });
@@ -232,7 +227,7 @@ private:
         [&](std::size_t i) { return static_cast<std::uint32_t>(words[i] & mask); });
       return;
     }
-    LargeVector<std::pair<std::uint64_t, std::uint32_t>> pairs(first.back());
+    LargeVector<std::pair<std::uint64_t, std::uint32_t>> pairs(first.End[0]);
     this->Pairs(first, parallel,
       [&](std::size_t at, std::int64_t key, std::size_t t) {
         pairs[at] = { static_cast<std::uint64_t>(key), static_cast<std::uint32_t>(t) };
@@ -291,14 +286,14 @@ private:
     }
   }
 
-  /// put(place, key, triangle) for each pair, chunk c's from first[c] on.
+  /// put(place, key, triangle) for each pair, chunk c's from first.At(c, 0) on.
   template <typename Parallel, typename Put>
-  void Pairs(const std::vector<std::size_t>& first, Parallel& parallel, Put&& put) const
+  void Pairs(ChunkPlaces& first, Parallel& parallel, Put&& put) const
   {
-    parallel(static_cast<std::int64_t>(first.size() - 1),
+    parallel(static_cast<std::int64_t>(first.Places.size()),
       [&](std::int64_t c)
       {
-        std::size_t at = first[static_cast<std::size_t>(c)];
+        std::size_t at = first.At(c, 0);
         this->ForBuckets(
           static_cast<std::size_t>(c), [&](std::int64_t key, std::size_t t) { put(at++, key, t); });
       });
@@ -320,21 +315,9 @@ private:
         }
       });
     // Each bucket's first pair: counted per range, then written at the range's place.
-    auto starts = [&keyAt](std::size_t i) { return i == 0 || keyAt(i) != keyAt(i - 1); };
-    std::vector<std::size_t> before(static_cast<std::size_t>(ranges) + 1, 0);
-    parallel(ranges,
-      [&](std::int64_t r)
-      {
-        const std::size_t last = std::min(pairs, (static_cast<std::size_t>(r) + 1) * Chunk);
-        for (std::size_t i = static_cast<std::size_t>(r) * Chunk; i < last; ++i)
-        {
-          before[static_cast<std::size_t>(r) + 1] += starts(i);
-        }
-      });
-    for (std::size_t r = 0; r + 1 < before.size(); ++r)
-    {
-      before[r + 1] += before[r];
-    }
+    auto starts = [&keyAt](std::int64_t i) { return i == 0 || keyAt(i) != keyAt(i - 1); };
+    const std::vector<std::size_t> before =
+      CountBefore(static_cast<std::int64_t>(pairs), Chunk, starts, parallel);
     this->Start.resize(before.back());
     parallel(ranges,
       [&](std::int64_t r)
