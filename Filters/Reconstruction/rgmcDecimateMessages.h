@@ -38,14 +38,22 @@ using Sending = std::array<vtkIdType, 3>;
 /// The triangles going to one rank (sized, then written whole on threads).
 using Sendings = rgmc::OverwriteVector<Sending>;
 
-/// A message of triangles for blocks: the counts of own and halo triangles, (block, three
-/// vertex ids) for each (the own ones first), then the records of their vertices, each once, by
-/// increasing id. Written in fixed chunks on threads (each part of the message has its place).
-inline void WriteTriangles(std::vector<vtkIdType>& words, Sendings& going, const SurfacePart& part)
+/// How many of `going` go to their own block: those come first (ListSendings lists them so).
+inline vtkIdType OwnSendings(const Sendings& going)
 {
-  std::stable_partition(going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; });
-  const auto halos =
-    std::count_if(going.begin(), going.end(), [](const Sending& s) { return s[2]; });
+  return std::partition_point(
+           going.begin(), going.end(), [](const Sending& s) { return s[2] == 0; }) -
+    going.begin();
+}
+
+/// A message of triangles for blocks: the counts of own and halo triangles, (block, three
+/// vertex ids) for each (the own ones first, as in `going`), then the records of their
+/// vertices, each once, by increasing id. Written in fixed chunks on threads (each part of the
+/// message has its place).
+inline void WriteTriangles(
+  std::vector<vtkIdType>& words, const Sendings& going, const SurfacePart& part)
+{
+  const vtkIdType halos = static_cast<vtkIdType>(going.size()) - OwnSendings(going);
   const vtkIdType n = static_cast<vtkIdType>(going.size()), chunk = rgmc::ElementChunk;
   // The corners' vertices, by id (each written once), first: the message's size is then known.
   using IdAndIndex = std::array<vtkIdType, 2>; // (id, part index)
@@ -189,17 +197,15 @@ inline void ReadTriangles(
 }
 
 /// What ReadTriangles reads from the message WriteTriangles writes of `staying` (this rank's
-/// triangles for its own blocks; put in the message's order here), taken from the part with no
-/// message: the same lists and the same records, on threads. The records are sorted by id as
-/// the message's are (a packed radix sort of the used vertices), so that the table's sort, once
-/// every message is read, finds them in place.
+/// triangles for its own blocks, the own ones first), taken from the part with no message: the
+/// same lists and the same records, on threads. The records are sorted by id as the message's
+/// are (a packed radix sort of the used vertices), so that the table's sort, once every message
+/// is read, finds them in place.
 inline void KeepTriangles(
-  Sendings& staying, const SurfacePart& part, std::vector<Block>& blocks, VertexTable& table)
+  const Sendings& staying, const SurfacePart& part, std::vector<Block>& blocks, VertexTable& table)
 {
-  std::stable_partition(staying.begin(), staying.end(), [](const Sending& s) { return s[2] == 0; });
   const vtkIdType n = static_cast<vtkIdType>(staying.size());
-  const vtkIdType own =
-    std::count_if(staying.begin(), staying.end(), [](const Sending& s) { return s[2] == 0; });
+  const vtkIdType own = OwnSendings(staying);
   auto corners = [&](vtkIdType t, vtkIdType c[3])
   { part.Corners(static_cast<std::size_t>(staying[t][1]), c); };
   AppendTriangles(

@@ -18,6 +18,7 @@
 #include "vtkPolyData.h"
 #include "vtkSMPTools.h"
 
+#include <algorithm>
 #include <array>
 #include <map>
 #include <random>
@@ -344,7 +345,7 @@ void TestKeepTriangles()
         }
       }
     }
-    // As SendTrianglesToBlocks lists them: by triangle, its own block and some halos.
+    // As ListSendings lists them: by triangle, its own block and some halos.
     rgmc::decimate::Sendings staying;
     for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
     {
@@ -359,13 +360,20 @@ void TestKeepTriangles()
           { 10 * (1 + static_cast<vtkIdType>(random() % count)), static_cast<vtkIdType>(t), 1 });
       }
     }
+    // Each rank's list holds the own ones first, as ListSendings lists them.
+    std::stable_partition(
+      staying.begin(), staying.end(), [](const rgmc::decimate::Sending& s) { return s[2] == 0; });
     const std::mt19937_64 first = random;
     std::vector<rgmc::decimate::Block> expected = BlocksAfterAMessage(first, count);
     rgmc::decimate::VertexTable expectedTable;
     expectedTable.HasQuadrics = part.HasQuadrics();
-    rgmc::decimate::Sendings going = staying;
     std::vector<vtkIdType> words;
-    rgmc::decimate::WriteTriangles(words, going, part);
+    rgmc::decimate::WriteTriangles(words, staying, part);
+    const auto halos = std::count_if(
+      staying.begin(), staying.end(), [](const rgmc::decimate::Sending& s) { return s[2] != 0; });
+    RGMC_CHECK(words[1] == halos && words[0] + words[1] == static_cast<vtkIdType>(staying.size()),
+      "the message counts " << words[0] << " own and " << words[1] << " halo triangles, not "
+                            << staying.size() - halos << " and " << halos);
     rgmc::decimate::ReadTriangles(words, expected, expectedTable);
     if (flavour == 1)
     {
@@ -376,9 +384,8 @@ void TestKeepTriangles()
       std::vector<rgmc::decimate::Block> kept = BlocksAfterAMessage(first, count);
       rgmc::decimate::VertexTable table;
       table.HasQuadrics = part.HasQuadrics();
-      rgmc::decimate::Sendings copy = staying;
       vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
-        [&]() { rgmc::decimate::KeepTriangles(copy, part, kept, table); });
+        [&]() { rgmc::decimate::KeepTriangles(staying, part, kept, table); });
       if (flavour == 1)
       {
         table.SortDistinct();
