@@ -38,6 +38,89 @@ using Sending = std::array<vtkIdType, 3>;
 /// The triangles going to one rank (sized, then written whole on threads).
 using Sendings = rgmc::OverwriteVector<Sending>;
 
+/// Where the part's triangles go: each one's block, each block's wave and rank, and the other
+/// blocks of the part's vertices that are in several (those of vertex v are SharedBlocks[i],
+/// SharedFirst[v] <= i < SharedFirst[v + 1]).
+struct TriangleRoutes
+{
+  const std::int32_t* PartBlock;
+  const int* WaveOf;
+  const int* Owner;
+  const std::uint32_t* SharedFirst;
+  const std::int32_t* SharedBlocks;
+};
+
+/// The part's triangles for the blocks of `wave`, per rank of the block (one list for each of
+/// `ranks`): to its own block if that is in the wave, and to the other blocks of
+/// the wave that share one of its vertices, as their halo. Each rank's list holds the own ones
+/// first, then the halos, each kind in order of triangle and, for a triangle's halos, of block.
+/// On threads: each chunk of triangles lists its sendings per rank and kind; they are then
+/// copied to their places (PlaceChunks).
+inline std::vector<Sendings> ListSendings(
+  const SurfacePart& part, const TriangleRoutes& routes, int wave, int ranks)
+{
+  const std::size_t size = static_cast<std::size_t>(ranks), kinds = 2 * size;
+  const vtkIdType n = static_cast<vtkIdType>(part.NumberOfTriangles());
+  std::vector<Sendings> found( // per chunk and kind: 2r own triangles of rank r, 2r + 1 halos
+    static_cast<std::size_t>(rgmc::ChunksOf(n, rgmc::ElementChunk)) * kinds);
+  rgmc::ChunkPlaces places =
+    rgmc::PlaceChunks(n, rgmc::ElementChunk, std::vector<std::size_t>(kinds, 0),
+      [&](vtkIdType chunk, vtkIdType begin, vtkIdType end, std::size_t* counts)
+      {
+        Sendings* lists = found.data() + static_cast<std::size_t>(chunk) * kinds;
+        std::vector<vtkIdType> others;
+        for (vtkIdType t = begin; t < end; ++t)
+        {
+          const vtkIdType block = routes.PartBlock[t];
+          if (routes.WaveOf[block] == wave)
+          {
+            lists[2 * routes.Owner[block]].push_back({ block, t, 0 });
+          }
+          vtkIdType c[3];
+          part.Corners(static_cast<std::size_t>(t), c);
+          others.clear();
+          for (vtkIdType v : c)
+          {
+            for (std::uint32_t i = routes.SharedFirst[v]; i < routes.SharedFirst[v + 1]; ++i)
+            {
+              const vtkIdType other = routes.SharedBlocks[i];
+              if (other != block && routes.WaveOf[other] == wave)
+              {
+                others.push_back(other);
+              }
+            }
+          }
+          std::sort(others.begin(), others.end());
+          others.erase(std::unique(others.begin(), others.end()), others.end());
+          for (vtkIdType other : others)
+          {
+            lists[2 * routes.Owner[other] + 1].push_back({ other, t, 1 });
+          }
+        }
+        for (std::size_t k = 0; k < kinds; ++k)
+        {
+          counts[k] = lists[k].size();
+        }
+      });
+  std::vector<Sendings> going(size);
+  for (std::size_t r = 0; r < size; ++r)
+  {
+    going[r].resize(places.End[2 * r] + places.End[2 * r + 1]);
+  }
+  rgmc::ForEachChunk(n, rgmc::ElementChunk,
+    [&](vtkIdType chunk, vtkIdType, vtkIdType)
+    {
+      for (std::size_t k = 0; k < kinds; ++k)
+      {
+        Sendings& list = found[static_cast<std::size_t>(chunk) * kinds + k];
+        const std::size_t at = places.At(chunk, k) + (k % 2 ? places.End[k - 1] : 0);
+        std::copy(list.begin(), list.end(), going[k / 2].begin() + at);
+        Sendings().swap(list);
+      }
+    });
+  return going;
+}
+
 /// How many of `going` go to their own block: those come first (ListSendings lists them so).
 inline vtkIdType OwnSendings(const Sendings& going)
 {

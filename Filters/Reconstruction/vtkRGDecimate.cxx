@@ -557,81 +557,13 @@ bool vtkRGDecimate::SendTriangles(Run& run, int wave)
 }
 
 //------------------------------------------------------------------------------
-// The part's triangles for the wave's blocks, per rank of the block: to its own block, and to
-// the other blocks of its vertices as their halo (the own ones first, each kind in order of
-// triangle and, for a triangle's halos, of block). On threads: each chunk of triangles lists its
-// sendings per rank and kind; they are then copied to their places (PlaceChunks).
-void vtkRGDecimate::ListSendings(Run& run, int wave)
-{
-  const std::size_t size = static_cast<std::size_t>(run.Ranks.Size), kinds = 2 * size;
-  const SurfacePart& part = run.Part;
-  const vtkIdType n = static_cast<vtkIdType>(part.NumberOfTriangles());
-  std::vector<Sendings> found( // per chunk and kind: 2r own triangles of rank r, 2r + 1 halos
-    static_cast<std::size_t>(rgmc::ChunksOf(n, rgmc::ElementChunk)) * kinds);
-  rgmc::ChunkPlaces places =
-    rgmc::PlaceChunks(n, rgmc::ElementChunk, std::vector<std::size_t>(kinds, 0),
-      [&](vtkIdType chunk, vtkIdType begin, vtkIdType end, std::size_t* counts)
-      {
-        Sendings* lists = found.data() + static_cast<std::size_t>(chunk) * kinds;
-        std::vector<vtkIdType> others;
-        for (vtkIdType t = begin; t < end; ++t)
-        {
-          const vtkIdType block = run.PartBlock[t];
-          if (run.WaveOf[block] == wave)
-          {
-            lists[2 * run.Owner[block]].push_back({ block, t, 0 });
-          }
-          vtkIdType c[3];
-          part.Corners(static_cast<std::size_t>(t), c);
-          others.clear();
-          for (vtkIdType v : c)
-          {
-            for (std::uint32_t i = run.SharedFirst[v]; i < run.SharedFirst[v + 1]; ++i)
-            {
-              const vtkIdType other = run.SharedBlocks[i];
-              if (other != block && run.WaveOf[other] == wave)
-              {
-                others.push_back(other);
-              }
-            }
-          }
-          std::sort(others.begin(), others.end());
-          others.erase(std::unique(others.begin(), others.end()), others.end());
-          for (vtkIdType other : others)
-          {
-            lists[2 * run.Owner[other] + 1].push_back({ other, t, 1 });
-          }
-        }
-        for (std::size_t k = 0; k < kinds; ++k)
-        {
-          counts[k] = lists[k].size();
-        }
-      });
-  std::vector<Sendings>& going = run.Going;
-  going.assign(size, Sendings());
-  for (std::size_t r = 0; r < size; ++r)
-  {
-    going[r].resize(places.End[2 * r] + places.End[2 * r + 1]);
-  }
-  rgmc::ForEachChunk(n, rgmc::ElementChunk,
-    [&](vtkIdType chunk, vtkIdType, vtkIdType)
-    {
-      for (std::size_t k = 0; k < kinds; ++k)
-      {
-        Sendings& list = found[static_cast<std::size_t>(chunk) * kinds + k];
-        const std::size_t at = places.At(chunk, k) + (k % 2 ? places.End[k - 1] : 0);
-        std::copy(list.begin(), list.end(), going[k / 2].begin() + at);
-        Sendings().swap(list);
-      }
-    });
-}
-
-//------------------------------------------------------------------------------
 // The messages of the part's triangles to the ranks of the wave's blocks (ListSendings); what
 // goes to this rank's own blocks stays in run.Going for AssembleBlocks, with no message.
 void vtkRGDecimate::SendTrianglesToBlocks(Run& run, int wave, Messages& outgoing)
 {
-  this->ListSendings(run, wave);
+  const TriangleRoutes routes{ run.PartBlock.data(), run.WaveOf.data(), run.Owner.data(),
+    run.SharedFirst.data(), run.SharedBlocks.data() };
+  run.Going = ListSendings(run.Part, routes, wave, run.Ranks.Size);
   for (int r = 0; r < run.Ranks.Size; ++r)
   {
     if (r != run.Ranks.Rank)

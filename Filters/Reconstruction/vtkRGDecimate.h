@@ -195,7 +195,6 @@ private:
   void AnswerSharedVertices(Run& run, Messages& asked, Messages& answers);
   void RecordSharedVertices(Run& run, const Messages& told);
   void SendTrianglesToBlocks(Run& run, int wave, Messages& outgoing);
-  void ListSendings(Run& run, int wave);
   void AssembleBlocks(Run& run, int wave, Messages& incoming);
   double SelectThreshold(Run& run, vtkIdType needed);
   void KeepUpToThreshold(Run& run, double threshold, vtkIdType needed);

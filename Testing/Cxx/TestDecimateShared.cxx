@@ -2,8 +2,9 @@
 // (rgmcDecimateShared.h, rgmcDecimateMessages.h) against plain serial versions of the same
 // rules, on 1, 2, 16 and 64 threads: the records each rank is sent (as a set, to the rank of the
 // vertex's id), the answers (to the word, in order), the blocks' lists and vertex records read
-// from a message (in message order, after what the lists held), and the same read from the
-// rank's own part with no message (KeepTriangles) against the message. The surfaces are
+// from a message (in message order, after what the lists held), the triangles listed for each
+// rank of a wave's blocks (ListSendings), and the same read from the rank's own part with no
+// message (KeepTriangles) against the message. The surfaces are
 // large enough for many chunks, so vertices whose triangles or records straddle a chunk's end
 // are met.
 #include "rgmcCheck.h"
@@ -312,6 +313,82 @@ std::vector<rgmc::decimate::Block> BlocksAfterAMessage(std::mt19937_64 random, i
   return blocks;
 }
 
+/// ListSendings against the serial loop it stands for: per rank, the triangles whose block is
+/// in the wave (in triangle order), then each triangle's other blocks of the wave through its
+/// shared vertices (in triangle order, then block order, each block once); for each of three
+/// waves on 3 ranks, with vertices in up to 3 other blocks, on 1, 2, 16 and 64 threads.
+void TestListSendings()
+{
+  std::mt19937_64 random(23);
+  Soup soup(150000, 250000, random);
+  rgmc::decimate::SurfacePart part;
+  part.Read(soup.Mesh);
+  const int blocks = 40, ranks = 3, waves = 3;
+  std::vector<int> waveOf(blocks), owner(blocks);
+  for (int b = 0; b < blocks; ++b)
+  {
+    waveOf[b] = static_cast<int>(random() % waves);
+    owner[b] = static_cast<int>(random() % ranks);
+  }
+  std::vector<std::uint32_t> sharedFirst(part.NumberOfVertices() + 1, 0);
+  std::vector<std::int32_t> sharedBlocks;
+  for (std::size_t v = 0; v < part.NumberOfVertices(); ++v)
+  {
+    for (int k = static_cast<int>(random() % 8); k < 3; ++k) // none for most vertices
+    {
+      sharedBlocks.push_back(static_cast<std::int32_t>(random() % blocks));
+    }
+    sharedFirst[v + 1] = static_cast<std::uint32_t>(sharedBlocks.size());
+  }
+  const rgmc::decimate::TriangleRoutes routes{ soup.Blocks.data(), waveOf.data(), owner.data(),
+    sharedFirst.data(), sharedBlocks.data() };
+  for (int wave = 0; wave < waves; ++wave)
+  {
+    std::vector<std::vector<rgmc::decimate::Sending>> own(ranks), halo(ranks);
+    for (std::size_t t = 0; t < part.NumberOfTriangles(); ++t)
+    {
+      const vtkIdType block = soup.Blocks[t], tri = static_cast<vtkIdType>(t);
+      if (waveOf[block] == wave)
+      {
+        own[owner[block]].push_back({ block, tri, 0 });
+      }
+      vtkIdType c[3];
+      part.Corners(t, c);
+      std::set<vtkIdType> others;
+      for (vtkIdType v : c)
+      {
+        for (std::uint32_t i = sharedFirst[v]; i < sharedFirst[v + 1]; ++i)
+        {
+          if (sharedBlocks[i] != block && waveOf[sharedBlocks[i]] == wave)
+          {
+            others.insert(sharedBlocks[i]);
+          }
+        }
+      }
+      for (vtkIdType other : others)
+      {
+        halo[owner[other]].push_back({ other, tri, 1 });
+      }
+    }
+    for (int threads : { 1, 2, 16, 64 })
+    {
+      std::vector<rgmc::decimate::Sendings> going;
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]() { going = rgmc::decimate::ListSendings(part, routes, wave, ranks); });
+      bool same = going.size() == static_cast<std::size_t>(ranks);
+      for (int r = 0; same && r < ranks; ++r)
+      {
+        std::vector<rgmc::decimate::Sending> expected = own[r];
+        expected.insert(expected.end(), halo[r].begin(), halo[r].end());
+        same = std::equal(going[r].begin(), going[r].end(), expected.begin(), expected.end()) &&
+          !expected.empty();
+      }
+      RGMC_CHECK(same,
+        "the sendings of wave " << wave << " equal the serial loop's on " << threads << " threads");
+    }
+  }
+}
+
 /// KeepTriangles against the message it stands for, ReadTriangles(WriteTriangles(...)): the
 /// blocks' lists (after what they held) and the records, word for word and in the same order
 /// (by id) for a part read from the input and for one of its own with quadrics; with negative
@@ -419,6 +496,7 @@ int main()
   TestVertexBlocks();
   TestAnswers();
   TestReadTriangles();
+  TestListSendings();
   TestKeepTriangles();
   return rgmc_test::Result("TestDecimateShared");
 }
