@@ -132,8 +132,9 @@ public:
   CollapsedBlocks() { this->Vertices.HasQuadrics = true; }
 
   /// Replays the kept collapses of the blocks from `first` to `last` in parallel (each block
-  /// alone), simplifying them first when made `again`; then copies and frees each block, in
-  /// order.
+  /// alone), simplifying them first when made `again`; then copies each block after those
+  /// before it (places counted per block, in block order, so the lists are the same on any
+  /// threads) and frees it, on threads.
   void Apply(std::vector<Block>::iterator first, std::vector<Block>::iterator last, bool again,
     double maximumError)
   {
@@ -142,8 +143,11 @@ public:
       this->Surface.reserve(this->Expected);
       this->Vertices.Reserve(this->Expected / 2 + this->Expected / 16);
     }
-    std::vector<std::vector<std::uint8_t>> used(static_cast<std::size_t>(last - first));
-    rgmc::ParallelFor(static_cast<vtkIdType>(last - first), 1,
+    const std::size_t blocks = static_cast<std::size_t>(last - first);
+    std::vector<std::vector<std::uint8_t>> used(blocks);
+    // Each block's triangles and used vertices, then where its copies go.
+    std::vector<std::size_t> triangles(blocks + 1, 0), records(blocks + 1, 0);
+    rgmc::ParallelFor(static_cast<vtkIdType>(blocks), 1,
       [&](vtkIdType from, vtkIdType to)
       {
         for (vtkIdType b = from; b < to; ++b)
@@ -159,44 +163,62 @@ public:
           {
             used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
           }
+          triangles[b + 1] = block.Mesh.Triangles.size();
+          records[b + 1] = static_cast<std::size_t>(std::count(used[b].begin(), used[b].end(), 1));
         }
       });
-    for (auto block = first; block != last; ++block)
+    triangles[0] = this->Surface.size();
+    records[0] = this->Vertices.Vertices.size();
+    for (std::size_t b = 0; b < blocks; ++b)
     {
-      const std::size_t b = static_cast<std::size_t>(block - first);
-      this->Copy(*block, used[b]);
-      *block = Block{ block->Id, block->Wave, {}, {}, {}, {}, {}, 0, 0, 0 };
-      std::vector<std::uint8_t>().swap(used[b]);
+      triangles[b + 1] += triangles[b];
+      records[b + 1] += records[b];
+      const Block& block = *(first + static_cast<std::ptrdiff_t>(b));
+      this->Kept += static_cast<vtkIdType>(block.Keep);
+      if (block.Keep > 0)
+      {
+        this->Level = std::max(this->Level, block.Levels[block.Keep - 1]);
+      }
     }
+    this->Surface.resize(triangles[blocks]);
+    this->Vertices.Grow(records[blocks] - this->Vertices.Vertices.size());
+    rgmc::ParallelFor(static_cast<vtkIdType>(blocks), 1,
+      [&](vtkIdType from, vtkIdType to)
+      {
+        for (vtkIdType b = from; b < to; ++b)
+        {
+          Block& block = *(first + b);
+          this->Copy(block, used[b], triangles[b], records[b]);
+          block = Block{ block.Id, block.Wave, {}, {}, {}, {}, {}, 0, 0, 0 };
+          std::vector<std::uint8_t>().swap(used[b]);
+        }
+      });
   }
 
-  std::vector<Triangle> Surface; // by global ids
-  VertexTable Vertices;          // of the triangles, as they come (Adopt sorts them)
-  vtkIdType Kept = 0;            // collapses
-  double Level = 0;              // the largest kept collapse's level
-  std::size_t Expected = 0;      // triangles, to size the lists once
+  rgmc::OverwriteVector<Triangle> Surface; // by global ids
+  VertexTable Vertices;                    // of the triangles, as they come (Adopt sorts them)
+  vtkIdType Kept = 0;                      // collapses
+  double Level = 0;                        // the largest kept collapse's level
+  std::size_t Expected = 0;                // triangles, to size the lists once
 
 private:
-  void Copy(const Block& block, const std::vector<std::uint8_t>& used)
+  /// The block's triangles from place `triangle` on, its used vertices' records from `record`.
+  void Copy(const Block& block, const std::vector<std::uint8_t>& used, std::size_t triangle,
+    std::size_t record)
   {
-    this->Kept += static_cast<vtkIdType>(block.Keep);
-    if (block.Keep > 0)
-    {
-      this->Level = std::max(this->Level, block.Levels[block.Keep - 1]);
-    }
     const rgmc::DecimationBlock& mesh = block.Mesh;
     for (const auto& t : mesh.Triangles)
     {
-      this->Surface.push_back({ mesh.Ids[t[0]], mesh.Ids[t[1]], mesh.Ids[t[2]] });
+      this->Surface[triangle++] = { mesh.Ids[t[0]], mesh.Ids[t[1]], mesh.Ids[t[2]] };
     }
     for (std::size_t v = 0; v < used.size(); ++v)
     {
       if (used[v])
       {
-        Vertex record;
-        record.Id = mesh.Ids[v];
-        std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, record.Point);
-        this->Vertices.Add(record, &mesh.Quadrics[v]);
+        Vertex& out = this->Vertices.Vertices[record];
+        out.Id = mesh.Ids[v];
+        std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, out.Point);
+        this->Vertices.Quadrics[record++] = mesh.Quadrics[v];
       }
     }
   }

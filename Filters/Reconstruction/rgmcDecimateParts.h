@@ -266,7 +266,7 @@ public:
 
   /// Takes the triangles (by global ids) and their vertices' records as the part's own: the
   /// records sorted by id with copies merged, the triangles turned into indices of them.
-  void Adopt(std::vector<Triangle>& byId, VertexTable& vertices)
+  void Adopt(rgmc::OverwriteVector<Triangle>& byId, VertexTable& vertices)
   {
     this->Clear();
     std::swap(this->Vertices, vertices);
@@ -275,9 +275,10 @@ public:
     {
       throw std::runtime_error("a rank's part of the surface has more than 2^31 vertices");
     }
-    this->Triangles.resize(byId.size());
-    rgmc::ForEachChunk(static_cast<vtkIdType>(byId.size()), rgmc::ElementChunk,
-      [&](vtkIdType, vtkIdType begin, vtkIdType end)
+    this->Triangles.resize(byId.size()); // written whole below
+    // Small tasks: each corner is a binary search, and a result never depends on the tasks.
+    rgmc::ParallelFor(static_cast<vtkIdType>(byId.size()), 8192,
+      [&](vtkIdType begin, vtkIdType end)
       {
         for (vtkIdType t = begin; t < end; ++t)
         {
@@ -287,7 +288,7 @@ public:
           }
         }
       });
-    std::vector<Triangle>().swap(byId);
+    rgmc::OverwriteVector<Triangle>().swap(byId);
   }
 
   /// Makes an input part the part's own (as Adopt would have it).
@@ -297,7 +298,7 @@ public:
     {
       return;
     }
-    std::vector<Triangle> byId(this->NumberOfTriangles());
+    rgmc::OverwriteVector<Triangle> byId(this->NumberOfTriangles()); // written whole below
     VertexTable vertices;
     std::vector<std::uint8_t> used(this->NumberOfVertices(), 0);
     for (std::size_t t = 0; t < byId.size(); ++t)
@@ -395,12 +396,13 @@ public:
     std::vector<vtkIdType>().swap(this->CornerCopy);
     this->PointsDouble = nullptr;
     this->PointsFloat = nullptr;
-    std::vector<std::array<std::int32_t, 3>>().swap(this->Triangles);
+    decltype(this->Triangles)().swap(this->Triangles);
     this->Vertices.Clear();
   }
 
-  std::vector<std::array<std::int32_t, 3>> Triangles; // the part's own: indices of Vertices
-  VertexTable Vertices;                               // the part's own: by increasing id
+  rgmc::OverwriteVector<std::array<std::int32_t, 3>>
+    Triangles;          // the part's own: indices of Vertices
+  VertexTable Vertices; // the part's own: by increasing id
 
 private:
   vtkPolyData* Input = nullptr; // the first pass: the input, in place

@@ -75,15 +75,17 @@ private:
 };
 
 /// The (vertex, block) pairs of the triangles' corners whose block is not the vertex's lowest,
-/// sorted, each once (few vertices have any).
+/// sorted, each once (few vertices have any). On threads: each chunk of triangles lists its
+/// pairs, copied to their places in chunk order, then radix-sorted as one word each (a vertex
+/// index and a block both fit in 32 bits).
 inline std::vector<std::pair<vtkIdType, vtkIdType>> OtherBlocks(
   const SurfacePart& part, const std::vector<std::int32_t>& partBlock, const LowestBlocks& lowest)
 {
   const vtkIdType nt = static_cast<vtkIdType>(part.NumberOfTriangles());
-  std::vector<std::vector<std::pair<vtkIdType, vtkIdType>>> found(
+  std::vector<std::vector<std::uint64_t>> found(
     static_cast<std::size_t>(ChunksOf(nt, ElementChunk)));
-  ForEachChunk(nt, ElementChunk,
-    [&](vtkIdType chunk, vtkIdType begin, vtkIdType end)
+  ChunkPlaces places = PlaceChunks(nt, ElementChunk, { 0 },
+    [&](vtkIdType chunk, vtkIdType begin, vtkIdType end, std::size_t* count)
     {
       for (vtkIdType t = begin; t < end; ++t)
       {
@@ -93,18 +95,29 @@ inline std::vector<std::pair<vtkIdType, vtkIdType>> OtherBlocks(
         {
           if (partBlock[t] != lowest[v])
           {
-            found[chunk].emplace_back(v, partBlock[t]);
+            found[chunk].push_back(
+              static_cast<std::uint64_t>(v) << 32 | static_cast<std::uint32_t>(partBlock[t]));
           }
         }
       }
+      *count = found[chunk].size();
     });
-  std::vector<std::pair<vtkIdType, vtkIdType>> more;
-  for (const auto& pairs : found)
+  OverwriteVector<std::uint64_t> words(places.End[0]); // written whole below
+  ForEachChunk(nt, ElementChunk,
+    [&](vtkIdType chunk, vtkIdType, vtkIdType)
+    {
+      std::copy(found[chunk].begin(), found[chunk].end(), words.begin() + places.At(chunk, 0));
+      std::vector<std::uint64_t>().swap(found[chunk]);
+    });
+  RadixSort(
+    words, [](std::uint64_t w) { return w; }, Tasks());
+  words.erase(std::unique(words.begin(), words.end()), words.end());
+  std::vector<std::pair<vtkIdType, vtkIdType>> more(words.size());
+  for (std::size_t i = 0; i < words.size(); ++i)
   {
-    more.insert(more.end(), pairs.begin(), pairs.end());
+    more[i] = { static_cast<vtkIdType>(words[i] >> 32),
+      static_cast<vtkIdType>(words[i] & 0xffffffffu) };
   }
-  std::sort(more.begin(), more.end());
-  more.erase(std::unique(more.begin(), more.end()), more.end());
   return more;
 }
 
