@@ -9,7 +9,7 @@
 #define rgmcSurfaceDistance_h
 
 #include "rgmcBuffer.h"
-#include "rgmcKeyMap.h"
+#include "rgmcKeyIndex.h"
 #include "rgmcRadixSort.h"
 
 #include <algorithm>
@@ -332,12 +332,8 @@ private:
           }
         }
       });
-    this->Index = KeyMap(this->Start.size());
-    for (std::size_t b = 0; b < this->Start.size(); ++b)
-    {
-      bool inserted;
-      this->Index.FindOrInsert(keyAt(this->Start[b]), static_cast<std::int32_t>(b), inserted);
-    }
+    this->Index = KeyIndex(
+      this->Start.size(), [&](std::size_t b) { return keyAt(this->Start[b]); }, parallel);
     this->Start.push_back(pairs);
   }
 
@@ -398,12 +394,12 @@ private:
           {
             continue;
           }
-          const std::int32_t* found = this->Index.Find(this->Key(x, y, z));
-          if (!found)
+          const std::int64_t found = this->Index.Find(this->Key(x, y, z));
+          if (found < 0)
           {
             continue;
           }
-          const std::size_t b = static_cast<std::size_t>(*found);
+          const std::size_t b = static_cast<std::size_t>(found);
           for (std::uint64_t i = this->Start[b]; i < this->Start[b + 1]; ++i)
           {
             const double* t = this->Corners + 9 * std::size_t(this->Items[i]);
@@ -419,7 +415,7 @@ private:
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
   int Dims[3] = { 1, 1, 1 };
-  KeyMap Index;                     // a bucket's key (Key) to its number b
+  KeyIndex Index;                   // a bucket's key (Key) to its number b
   std::vector<std::uint64_t> Start; // bucket b's items: [Start[b], Start[b + 1])
   std::vector<std::uint32_t> Items;
 };
