@@ -187,6 +187,48 @@ public:
     this->Quadrics.resize(this->HasQuadrics ? kept : 0);
   }
 
+  /// SortDistinct's result on threads, out of place: the records gathered in id order into
+  /// new arrays, each id's first (so the records are held twice meanwhile: for a table whose
+  /// moment is not the pass's peak, the part's at the end of a pass). Ids the packed sort
+  /// cannot take (negative ones) are sorted in place by SortDistinct.
+  void SortDistinctGathered()
+  {
+    const std::size_t n = this->Vertices.size();
+    rgmc::OverwriteVector<std::size_t> from(n); // the record at each sorted place
+    if (!rgmc::RadixSortPacked(
+          n, [this](std::size_t i) { return static_cast<std::uint64_t>(this->Vertices[i].Id); },
+          [&from](std::size_t at, std::uint64_t, std::size_t i) { from[at] = i; }, rgmc::Tasks()))
+    {
+      this->SortDistinct();
+      return;
+    }
+    auto isFirst = [&](vtkIdType i)
+    { return i == 0 || this->Vertices[from[i]].Id != this->Vertices[from[i - 1]].Id; };
+    const std::vector<std::size_t> before =
+      rgmc::CountBefore(static_cast<vtkIdType>(n), rgmc::ElementChunk, isFirst);
+    decltype(this->Vertices) vertices(before.back()); // written whole below
+    std::vector<rgmc::Quadric> quadrics(this->HasQuadrics ? before.back() : 0);
+    rgmc::ForEachChunk(static_cast<vtkIdType>(n), rgmc::ElementChunk,
+      [&](vtkIdType c, vtkIdType begin, vtkIdType end)
+      {
+        std::size_t at = before[static_cast<std::size_t>(c)];
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          if (isFirst(i))
+          {
+            vertices[at] = this->Vertices[from[i]];
+            if (this->HasQuadrics)
+            {
+              quadrics[at] = this->Quadrics[from[i]];
+            }
+            ++at;
+          }
+        }
+      });
+    this->Vertices.swap(vertices);
+    this->Quadrics.swap(quadrics);
+  }
+
   void Clear()
   {
     decltype(this->Vertices)().swap(this->Vertices);
@@ -270,7 +312,7 @@ public:
   {
     this->Clear();
     std::swap(this->Vertices, vertices);
-    this->Vertices.SortDistinct();
+    this->Vertices.SortDistinctGathered();
     if (this->Vertices.Vertices.size() > static_cast<std::size_t>(VTK_INT_MAX))
     {
       throw std::runtime_error("a rank's part of the surface has more than 2^31 vertices");

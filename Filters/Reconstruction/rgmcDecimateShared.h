@@ -137,9 +137,15 @@ inline void WriteVertexBlocks(const SurfacePart& part, const LowestBlocks& lowes
         counts[static_cast<std::size_t>(part.Id(v)) % size] += lowest[v] != LowestBlocks::NoBlock;
       }
     });
+  // `more` after the lowest blocks: each message sized once for both.
+  std::vector<std::size_t> after = records.End;
+  for (const auto& vb : more)
+  {
+    ++after[static_cast<std::size_t>(part.Id(vb.first)) % size];
+  }
   for (std::size_t r = 0; r < size; ++r)
   {
-    outgoing[r].resize(3 * records.End[r]);
+    outgoing[r].resize(3 * after[r]);
   }
   ForEachChunk(nv, ElementChunk,
     [&](vtkIdType c, vtkIdType begin, vtkIdType end)
@@ -160,8 +166,11 @@ inline void WriteVertexBlocks(const SurfacePart& part, const LowestBlocks& lowes
   for (const auto& vb : more)
   {
     const vtkIdType id = part.Id(vb.first);
-    auto& words = outgoing[static_cast<std::size_t>(id) % size];
-    words.insert(words.end(), { id, vb.first, vb.second });
+    const std::size_t r = static_cast<std::size_t>(id) % size;
+    vtkIdType* out = outgoing[r].data() + 3 * records.End[r]++;
+    out[0] = id;
+    out[1] = vb.first;
+    out[2] = vb.second;
   }
 }
 

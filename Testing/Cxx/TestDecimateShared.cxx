@@ -4,9 +4,9 @@
 // vertex's id), the answers (to the word, in order), the blocks' lists and vertex records read
 // from a message (in message order, after what the lists held), the triangles listed for each
 // rank of a wave's blocks (ListSendings), and the same read from the rank's own part with no
-// message (KeepTriangles) against the message. The surfaces are
-// large enough for many chunks, so vertices whose triangles or records straddle a chunk's end
-// are met.
+// message (KeepTriangles) against the message, and the part's vertex table sorted out of place
+// (SortDistinctGathered) against the in-place sort. The surfaces are large enough for many
+// chunks, so vertices whose triangles or records straddle a chunk's end are met.
 #include "rgmcCheck.h"
 #include "rgmcDecimateMessages.h"
 #include "rgmcDecimateShared.h"
@@ -313,6 +313,67 @@ std::vector<rgmc::decimate::Block> BlocksAfterAMessage(std::mt19937_64 random, i
   return blocks;
 }
 
+/// SortDistinctGathered against SortDistinct: the same records, word for word, for tables with
+/// copies of records (equal, as a vertex's copies are), with and without quadrics, and with
+/// negative ids (which the packed sort cannot take); on 1, 2, 16 and 64 threads.
+void TestSortDistinctGathered()
+{
+  std::mt19937_64 random(29);
+  for (int flavour : { 0, 1, 2 }) // without quadrics; with; negative ids
+  {
+    rgmc::decimate::VertexTable table;
+    table.HasQuadrics = flavour != 0;
+    std::vector<rgmc::decimate::Vertex> distinct(100000);
+    std::vector<rgmc::Quadric> terms(distinct.size());
+    for (std::size_t i = 0; i < distinct.size(); ++i)
+    {
+      distinct[i].Id = static_cast<vtkIdType>(random() % 1000000000) * (flavour == 2 ? -1 : 1);
+      for (double& x : distinct[i].Point)
+      {
+        x = static_cast<double>(random() % 100000) / 3.0;
+      }
+      for (double& t : terms[i].Terms)
+      {
+        t = static_cast<double>(random() % 100000) / 7.0;
+      }
+    }
+    for (int k = 0; k < 250000; ++k) // each record once or more, in no order
+    {
+      const std::size_t i = k < 100000 ? static_cast<std::size_t>(k) : random() % distinct.size();
+      table.Add(distinct[i], &terms[i]);
+    }
+    for (std::size_t i = table.Vertices.size() - 1; i > 0; --i)
+    {
+      const std::size_t j = random() % (i + 1);
+      std::swap(table.Vertices[i], table.Vertices[j]);
+      if (table.HasQuadrics)
+      {
+        std::swap(table.Quadrics[i], table.Quadrics[j]);
+      }
+    }
+    rgmc::decimate::VertexTable expected = table;
+    expected.SortDistinct();
+    for (int threads : { 1, 2, 16, 64 })
+    {
+      rgmc::decimate::VertexTable gathered = table;
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]() { gathered.SortDistinctGathered(); });
+      bool same = gathered.Vertices.size() == expected.Vertices.size() &&
+        gathered.Quadrics.size() == expected.Quadrics.size();
+      std::vector<vtkIdType> a(table.Words()), b(table.Words());
+      for (std::size_t i = 0; same && i < gathered.Vertices.size(); ++i)
+      {
+        gathered.Write(i, a.data());
+        expected.Write(i, b.data());
+        same = a == b;
+      }
+      RGMC_CHECK(same,
+        "SortDistinctGathered equals SortDistinct, flavour " << flavour << ", " << threads
+                                                             << " threads");
+    }
+  }
+}
+
 /// ListSendings against the serial loop it stands for: per rank, the triangles whose block is
 /// in the wave (in triangle order), then each triangle's other blocks of the wave through its
 /// shared vertices (in triangle order, then block order, each block once); for each of three
@@ -496,6 +557,7 @@ int main()
   TestVertexBlocks();
   TestAnswers();
   TestReadTriangles();
+  TestSortDistinctGathered();
   TestListSendings();
   TestKeepTriangles();
   return rgmc_test::Result("TestDecimateShared");
