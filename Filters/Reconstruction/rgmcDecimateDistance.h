@@ -98,6 +98,10 @@ struct DistanceSurface
   }
 
 private:
+  /// Points or cells a task reads (a fourth of ElementChunk: reading a triangle's corners costs
+  /// more than most passes' elements; the results never depend on it).
+  static constexpr vtkIdType ReadChunk = 16384;
+
   /// The points that are not Seam Repair's duplicate copies, in order (chunks on threads).
   void ReadPoints(vtkPolyData* pd, vtkPoints* points)
   {
@@ -107,9 +111,9 @@ private:
     auto kept = [ghost](vtkIdType i)
     { return !ghost || !(ghost[i] & vtkDataSetAttributes::DUPLICATEPOINT); };
     const vtkIdType n = points->GetNumberOfPoints();
-    const std::vector<std::size_t> first = CountBefore(n, ElementChunk, kept);
+    const std::vector<std::size_t> first = CountBefore(n, ReadChunk, kept);
     this->Points.resize(3 * first.back());
-    ForEachChunk(n, ElementChunk,
+    ForEachChunk(n, ReadChunk,
       [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
         double* out = this->Points.data() + 3 * first[static_cast<std::size_t>(c)];
@@ -129,11 +133,11 @@ private:
   void ReadTriangles(vtkPoints* points, vtkIdType cells, const Offset* offsets, const Id* ids)
   {
     std::vector<std::array<double, 6>> boxes(
-      static_cast<std::size_t>(ChunksOf(cells, ElementChunk)));
+      static_cast<std::size_t>(ChunksOf(cells, ReadChunk)));
     auto isTriangle = [offsets](vtkIdType c) { return offsets[c + 1] - offsets[c] == 3; };
-    const std::vector<std::size_t> first = CountBefore(cells, ElementChunk, isTriangle);
+    const std::vector<std::size_t> first = CountBefore(cells, ReadChunk, isTriangle);
     this->Triangles.resize(9 * first.back());
-    ForEachChunk(cells, ElementChunk,
+    ForEachChunk(cells, ReadChunk,
       [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
         std::array<double, 6>& box = boxes[static_cast<std::size_t>(c)];
