@@ -205,8 +205,9 @@ inline OverwriteVector<AskedRecord> AskedRecords(VertexBlocks& asked)
 }
 
 /// To each rank that asked about a vertex in several blocks, (its index of the vertex, block)
-/// for each of them, in order of vertex id. The records (AskedRecords) are cut into fixed
-/// chunks, each taking the vertices that start in it, answered on threads and joined in order.
+/// for each of them, in order of vertex id (`answers`: one empty message per rank). The records
+/// (AskedRecords) are cut into fixed chunks, each taking the vertices that start in it, answered on
+/// threads and joined in order.
 inline void AnswerSharedVertices(const OverwriteVector<AskedRecord>& all, VertexBlocks& answers)
 {
   const std::size_t size = answers.size();
@@ -254,13 +255,31 @@ inline void AnswerSharedVertices(const OverwriteVector<AskedRecord>& all, Vertex
         }
       }
     });
-  for (const VertexBlocks& part : parts)
+  // Joined in chunk order: each chunk's answers to rank r after the chunks' before it, copied
+  // on threads.
+  std::vector<std::size_t> at(parts.size() * size), total(size, 0);
+  for (std::size_t c = 0; c < parts.size(); ++c)
   {
     for (std::size_t r = 0; r < size; ++r)
     {
-      answers[r].insert(answers[r].end(), part[r].begin(), part[r].end());
+      at[c * size + r] = total[r];
+      total[r] += parts[c][r].size();
     }
   }
+  for (std::size_t r = 0; r < size; ++r)
+  {
+    answers[r].resize(total[r]);
+  }
+  ForEachChunk(n, ElementChunk,
+    [&](vtkIdType chunk, vtkIdType, vtkIdType)
+    {
+      const std::size_t c = static_cast<std::size_t>(chunk);
+      for (std::size_t r = 0; r < size; ++r)
+      {
+        std::copy(parts[c][r].begin(), parts[c][r].end(), answers[r].begin() + at[c * size + r]);
+        std::vector<vtkIdType>().swap(parts[c][r]);
+      }
+    });
 }
 
 } // namespace decimate
