@@ -145,50 +145,43 @@ public:
     }
     const std::size_t blocks = static_cast<std::size_t>(last - first);
     std::vector<std::vector<std::uint8_t>> used(blocks);
-    // Each block's triangles and used vertices, then where its copies go.
-    std::vector<std::size_t> triangles(blocks + 1, 0), records(blocks + 1, 0);
-    rgmc::ParallelFor(static_cast<vtkIdType>(blocks), 1,
-      [&](vtkIdType from, vtkIdType to)
+    // Each block replayed (one a task), its triangles and used vertices counted; their places
+    // after the lists' present ends, in block order.
+    rgmc::ChunkPlaces places = rgmc::PlaceChunks(static_cast<vtkIdType>(blocks), 1,
+      { this->Surface.size(), this->Vertices.Vertices.size() },
+      [&](vtkIdType b, vtkIdType, vtkIdType, std::size_t* counts)
       {
-        for (vtkIdType b = from; b < to; ++b)
+        Block& block = *(first + b);
+        if (again)
         {
-          Block& block = *(first + b);
-          if (again)
-          {
-            block.Log = rgmc::Simplify(block.Mesh, maximumError, block.Keep);
-          }
-          rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
-          used[b].assign(block.Mesh.Ids.size(), 0);
-          for (const auto& t : block.Mesh.Triangles)
-          {
-            used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
-          }
-          triangles[b + 1] = block.Mesh.Triangles.size();
-          records[b + 1] = static_cast<std::size_t>(std::count(used[b].begin(), used[b].end(), 1));
+          block.Log = rgmc::Simplify(block.Mesh, maximumError, block.Keep);
         }
+        rgmc::ApplyCollapses(block.Mesh, block.Log, block.Keep);
+        used[b].assign(block.Mesh.Ids.size(), 0);
+        for (const auto& t : block.Mesh.Triangles)
+        {
+          used[b][t[0]] = used[b][t[1]] = used[b][t[2]] = 1;
+        }
+        counts[0] = block.Mesh.Triangles.size();
+        counts[1] = static_cast<std::size_t>(std::count(used[b].begin(), used[b].end(), 1));
       });
-    triangles[0] = this->Surface.size();
-    records[0] = this->Vertices.Vertices.size();
-    for (std::size_t b = 0; b < blocks; ++b)
+    for (auto block = first; block != last; ++block)
     {
-      triangles[b + 1] += triangles[b];
-      records[b + 1] += records[b];
-      const Block& block = *(first + static_cast<std::ptrdiff_t>(b));
-      this->Kept += static_cast<vtkIdType>(block.Keep);
-      if (block.Keep > 0)
+      this->Kept += static_cast<vtkIdType>(block->Keep);
+      if (block->Keep > 0)
       {
-        this->Level = std::max(this->Level, block.Levels[block.Keep - 1]);
+        this->Level = std::max(this->Level, block->Levels[block->Keep - 1]);
       }
     }
-    this->Surface.resize(triangles[blocks]);
-    this->Vertices.Grow(records[blocks] - this->Vertices.Vertices.size());
+    this->Surface.resize(places.End[0]);
+    this->Vertices.Grow(places.End[1] - this->Vertices.Vertices.size());
     rgmc::ParallelFor(static_cast<vtkIdType>(blocks), 1,
       [&](vtkIdType from, vtkIdType to)
       {
         for (vtkIdType b = from; b < to; ++b)
         {
           Block& block = *(first + b);
-          this->Copy(block, used[b], triangles[b], records[b]);
+          this->Copy(block, used[b], places.At(b, 0), places.At(b, 1));
           block = Block{ block.Id, block.Wave, {}, {}, {}, {}, {}, 0, 0, 0 };
           std::vector<std::uint8_t>().swap(used[b]);
         }

@@ -221,8 +221,9 @@ inline void AnswerSharedVertices(const OverwriteVector<AskedRecord>& all, Vertex
     return i;
   };
   std::vector<VertexBlocks> parts(static_cast<std::size_t>(ChunksOf(n, ElementChunk)));
-  ForEachChunk(n, ElementChunk,
-    [&](vtkIdType chunk, vtkIdType begin, vtkIdType end)
+  // Each chunk's answers per rank, then their places (in chunk order) in the messages.
+  ChunkPlaces places = PlaceChunks(n, ElementChunk, std::vector<std::size_t>(size, 0),
+    [&](vtkIdType chunk, vtkIdType begin, vtkIdType end, std::size_t* counts)
     {
       VertexBlocks& part = parts[chunk];
       part.resize(size);
@@ -254,21 +255,14 @@ inline void AnswerSharedVertices(const OverwriteVector<AskedRecord>& all, Vertex
           }
         }
       }
+      for (std::size_t r = 0; r < size; ++r)
+      {
+        counts[r] = part[r].size();
+      }
     });
-  // Joined in chunk order: each chunk's answers to rank r after the chunks' before it, copied
-  // on threads.
-  std::vector<std::size_t> at(parts.size() * size), total(size, 0);
-  for (std::size_t c = 0; c < parts.size(); ++c)
-  {
-    for (std::size_t r = 0; r < size; ++r)
-    {
-      at[c * size + r] = total[r];
-      total[r] += parts[c][r].size();
-    }
-  }
   for (std::size_t r = 0; r < size; ++r)
   {
-    answers[r].resize(total[r]);
+    answers[r].resize(places.End[r]);
   }
   ForEachChunk(n, ElementChunk,
     [&](vtkIdType chunk, vtkIdType, vtkIdType)
@@ -276,7 +270,7 @@ inline void AnswerSharedVertices(const OverwriteVector<AskedRecord>& all, Vertex
       const std::size_t c = static_cast<std::size_t>(chunk);
       for (std::size_t r = 0; r < size; ++r)
       {
-        std::copy(parts[c][r].begin(), parts[c][r].end(), answers[r].begin() + at[c * size + r]);
+        std::copy(parts[c][r].begin(), parts[c][r].end(), answers[r].begin() + places.At(chunk, r));
         std::vector<vtkIdType>().swap(parts[c][r]);
       }
     });

@@ -313,6 +313,21 @@ std::vector<rgmc::decimate::Block> BlocksAfterAMessage(std::mt19937_64 random, i
   return blocks;
 }
 
+/// Whether two vertex tables hold the same records, word for word, in the same order.
+bool SameRecords(const rgmc::decimate::VertexTable& one, const rgmc::decimate::VertexTable& other)
+{
+  bool same = one.Vertices.size() == other.Vertices.size() &&
+    one.Quadrics.size() == other.Quadrics.size() && one.Words() == other.Words();
+  std::vector<vtkIdType> a(one.Words()), b(other.Words());
+  for (std::size_t i = 0; same && i < one.Vertices.size(); ++i)
+  {
+    one.Write(i, a.data());
+    other.Write(i, b.data());
+    same = a == b;
+  }
+  return same;
+}
+
 /// SortDistinctGathered against SortDistinct: the same records, word for word, for tables with
 /// copies of records (equal, as a vertex's copies are), with and without quadrics, and with
 /// negative ids (which the packed sort cannot take); on 1, 2, 16 and 64 threads.
@@ -358,16 +373,7 @@ void TestSortDistinctGathered()
       rgmc::decimate::VertexTable gathered = table;
       vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
         [&]() { gathered.SortDistinctGathered(); });
-      bool same = gathered.Vertices.size() == expected.Vertices.size() &&
-        gathered.Quadrics.size() == expected.Quadrics.size();
-      std::vector<vtkIdType> a(table.Words()), b(table.Words());
-      for (std::size_t i = 0; same && i < gathered.Vertices.size(); ++i)
-      {
-        gathered.Write(i, a.data());
-        expected.Write(i, b.data());
-        same = a == b;
-      }
-      RGMC_CHECK(same,
+      RGMC_CHECK(SameRecords(gathered, expected),
         "SortDistinctGathered equals SortDistinct, flavour " << flavour << ", " << threads
                                                              << " threads");
     }
@@ -535,15 +541,7 @@ void TestKeepTriangles()
       }
       RGMC_CHECK(lists,
         "the lists kept equal the message's, flavour " << flavour << ", " << threads << " threads");
-      bool records = table.Vertices.size() == expectedTable.Vertices.size();
-      std::vector<vtkIdType> a(table.Words()), b(table.Words());
-      for (std::size_t i = 0; records && i < table.Vertices.size(); ++i)
-      {
-        table.Write(i, a.data());
-        expectedTable.Write(i, b.data());
-        records = a == b;
-      }
-      RGMC_CHECK(records,
+      RGMC_CHECK(SameRecords(table, expectedTable),
         "the records kept equal the message's, flavour " << flavour << ", " << threads
                                                          << " threads");
     }
