@@ -127,10 +127,32 @@ inline void CanonicalTriangle(double t[9])
 /// every bucket its bounding box overlaps. Built on tasks (`parallel`, as the radix sort's):
 /// the (bucket, triangle) pairs of fixed chunks of triangles, sorted by bucket; a bucket's
 /// triangles are in increasing order whatever the threads (not that a search would care: the
-/// smallest distance is the same in any order).
+/// smallest distance is the same in any order). A search visits the buckets shell by shell
+/// around its point and skips a bucket, or a triangle, whose box is farther than the best
+/// distance so far (in each bucket the triangle whose box is nearest is measured first); what
+/// it returns is the minimum over all triangles within its limit, to the bit (TestSurfaceDistance
+/// holds it to the brute force).
 class TriangleBuckets
 {
 public:
+  /// The buckets a search looked up lately, by key (direct-mapped): searches from nearby points,
+  /// one after another, look up the same buckets, and each lookup in the index is a cache miss
+  /// (its slots are scattered on purpose). A memo per thread of searches; what a search finds
+  /// never depends on it.
+  class Memo
+  {
+  public:
+    Memo() { std::fill(this->Keys, this->Keys + Size, std::int64_t(-1)); }
+
+  private:
+    friend class TriangleBuckets;
+    static constexpr std::size_t Size = 512;
+    std::int64_t Keys[Size];
+    std::int64_t Found[Size];
+    std::vector<double> Boxes; // a bucket's triangles' box distances (VisitBucket)
+    std::size_t Cursor = 0;    // the last home bucket found
+  };
+
   /// `corners`: 9 coordinates a triangle (a contiguous container of doubles: a std::vector with
   /// any allocator), kept by reference; `size`: the buckets' edge.
   template <typename Container, typename Parallel = SerialTasks>
@@ -146,6 +168,13 @@ public:
   /// within limit"). Infinity when there is no triangle within reach.
   double Nearest2(const double p[3], double limit) const
   {
+    Memo memo;
+    return this->Nearest2(p, limit, memo);
+  }
+
+  /// Nearest2, with the buckets' lookups remembered in `memo` for the next searches.
+  double Nearest2(const double p[3], double limit, Memo& memo) const
+  {
     double best = std::numeric_limits<double>::infinity();
     if (this->Start.empty())
     {
@@ -159,16 +188,61 @@ public:
     }
     const int shells = static_cast<int>(std::min<double>(std::ceil(limit / this->Size) + 1,
       std::max({ this->Dims[0], this->Dims[1], this->Dims[2] })));
+    // How far p is inside its home bucket (negative outside it): no bucket of shell s >= 1 is
+    // nearer than inside + (s - 1) * Size, so most searches end with the home bucket.
+    double inside = std::numeric_limits<double>::max();
+    for (int a = 0; a < 3; ++a)
+    {
+      const double lo = this->Origin[a] + home[a] * this->Size;
+      inside = std::min({ inside, p[a] - lo, lo + this->Size - p[a] });
+    }
     for (int s = 0; s <= shells; ++s)
     {
-      const double gap = (s - 1) * this->Size; // no bucket of shell s is nearer than this
-      if (s > 1 && gap * gap > std::min(best, reach2))
+      const double gap = std::max(inside + (s - 1) * this->Size, (s - 1) * this->Size);
+      if (s > 0 && gap > std::sqrt(std::min(best, reach2)) * (1 + 1e-9) + this->Slack)
       {
         break;
       }
-      this->VisitShell(p, home, s, std::min(best, reach2), best);
+      this->VisitShell(p, home, s, std::min(best, reach2), best, memo);
     }
     return best;
+  }
+
+  /// The order in which to search from the points p[3 i], 0 <= i < n, so that searches one after
+  /// another read the same buckets: by home bucket (an index i a word, `order & IndexMask`).
+  /// The points' own order where a bucket's key and an index do not fit one word.
+  template <typename Parallel = SerialTasks>
+  OverwriteVector<std::uint64_t> HomeOrder(const double* p, std::size_t n, std::uint64_t& indexMask,
+    Parallel&& parallel = Parallel()) const
+  {
+    OverwriteVector<std::uint64_t> order(n); // filled whole below
+    int indexBits = 1;
+    while ((std::uint64_t(1) << indexBits) < n)
+    {
+      ++indexBits;
+    }
+    indexMask = (std::uint64_t(1) << indexBits) - 1;
+    const bool fits = this->KeyBits() + indexBits <= 64;
+    const std::int64_t chunks = static_cast<std::int64_t>((n + Chunk - 1) / Chunk);
+    parallel(chunks,
+      [&](std::int64_t c)
+      {
+        const std::size_t last = std::min(n, (static_cast<std::size_t>(c) + 1) * Chunk);
+        for (std::size_t i = static_cast<std::size_t>(c) * Chunk; i < last; ++i)
+        {
+          const double* q = p + 3 * i;
+          const std::uint64_t key = fits ? static_cast<std::uint64_t>(this->Key(this->Cell(q[0], 0),
+                                             this->Cell(q[1], 1), this->Cell(q[2], 2)))
+                                         : 0;
+          order[i] = key << indexBits | i;
+        }
+      });
+    if (fits)
+    {
+      RadixSort(
+        order, [indexBits](std::uint64_t w) { return w >> indexBits; }, parallel);
+    }
+    return order;
   }
 
 private:
@@ -201,17 +275,12 @@ private:
       parallel);
     // A pair as one word (the bucket's key above the triangle's bits) where it fits, else as
     // two; sorted by key, stably, so each bucket's triangles stay in increasing order.
-    int triangleBits = 1, keyBits = 1;
+    int triangleBits = 1;
     while ((std::uint64_t(1) << triangleBits) < n)
     {
       ++triangleBits;
     }
-    const std::uint64_t lastKey = static_cast<std::uint64_t>(
-      this->Key(this->Dims[0] - 1, this->Dims[1] - 1, this->Dims[2] - 1));
-    while (keyBits < 64 && (lastKey >> keyBits) != 0)
-    {
-      ++keyBits;
-    }
+    const int keyBits = this->KeyBits();
     if (keyBits + triangleBits <= 64)
     {
       OverwriteVector<std::uint64_t> words(first.End[0]); // filled whole by Pairs
@@ -279,11 +348,14 @@ private:
     {
       this->Size = 1;
     }
+    double magnitude = 0;
     for (int a = 0; a < 3; ++a)
     {
       this->Origin[a] = lo[a];
       this->Dims[a] = std::max(1, static_cast<int>(std::floor((hi[a] - lo[a]) / this->Size)) + 1);
+      magnitude = std::max({ magnitude, std::abs(lo[a]), std::abs(hi[a]) });
     }
+    this->Slack = 1e-9 * magnitude;
   }
 
   /// put(place, key, triangle) for each pair, chunk c's from first.At(c, 0) on.
@@ -332,8 +404,19 @@ private:
           }
         }
       });
+    this->Keys.resize(this->Start.size());
+    parallel(static_cast<std::int64_t>((this->Keys.size() + Chunk - 1) / Chunk),
+      [&](std::int64_t r)
+      {
+        const std::size_t last =
+          std::min(this->Keys.size(), (static_cast<std::size_t>(r) + 1) * Chunk);
+        for (std::size_t b = static_cast<std::size_t>(r) * Chunk; b < last; ++b)
+        {
+          this->Keys[b] = keyAt(this->Start[b]);
+        }
+      });
     this->Index = KeyIndex(
-      this->Start.size(), [&](std::size_t b) { return keyAt(this->Start[b]); }, parallel);
+      this->Keys.size(), [&](std::size_t b) { return this->Keys[b]; }, parallel);
     this->Start.push_back(pairs);
   }
 
@@ -364,14 +447,29 @@ private:
     }
   }
 
+  /// The bits the largest bucket key needs.
+  int KeyBits() const
+  {
+    const std::uint64_t lastKey = static_cast<std::uint64_t>(
+      this->Key(this->Dims[0] - 1, this->Dims[1] - 1, this->Dims[2] - 1));
+    int bits = 1;
+    while (bits < 64 && (lastKey >> bits) != 0)
+    {
+      ++bits;
+    }
+    return bits;
+  }
+
   std::int64_t Key(int x, int y, int z) const
   {
     return x + std::int64_t(this->Dims[0]) * (y + std::int64_t(this->Dims[1]) * z);
   }
 
   /// The buckets at Chebyshev distance s from `home` whose box is within `bound` (squared) of p.
-  void VisitShell(const double p[3], const int home[3], int s, double bound, double& best) const
+  void VisitShell(
+    const double p[3], const int home[3], int s, double bound, double& best, Memo& memo) const
   {
+    double cutoff = this->Cutoff(best);
     for (int z = home[2] - s; z <= home[2] + s; ++z)
     {
       for (int y = home[1] - s; y <= home[1] + s; ++y)
@@ -387,35 +485,120 @@ private:
           {
             inside = c[a] >= 0 && c[a] < this->Dims[a];
             const double lo = this->Origin[a] + c[a] * this->Size;
-            const double d = p[a] < lo ? lo - p[a] : std::max(0.0, p[a] - (lo + this->Size));
+            const double d = std::max(std::max(0.0, lo - p[a]), p[a] - (lo + this->Size));
             box2 += d * d;
           }
           if (!inside || box2 > std::min(bound, best))
           {
             continue;
           }
-          const std::int64_t found = this->Index.Find(this->Key(x, y, z));
+          const std::int64_t found = this->Find(this->Key(x, y, z), memo, s == 0);
           if (found < 0)
           {
             continue;
           }
-          const std::size_t b = static_cast<std::size_t>(found);
-          for (std::uint64_t i = this->Start[b]; i < this->Start[b + 1]; ++i)
-          {
-            const double* t = this->Corners + 9 * std::size_t(this->Items[i]);
-            best = std::min(best, PointTriangleDistance2(p, t, t + 3, t + 6));
-          }
+          this->VisitBucket(p, static_cast<std::size_t>(found), best, cutoff, memo);
         }
       }
     }
+  }
+
+  /// The triangles of bucket b against p: the one whose box is nearest first (it gives a small
+  /// best, which cuts off most of the others), then those whose box is within the cutoff.
+  void VisitBucket(const double p[3], std::size_t b, double& best, double& cutoff, Memo& memo) const
+  {
+    const std::uint64_t first = this->Start[b], count = this->Start[b + 1] - first;
+    std::vector<double>& box2 = memo.Boxes;
+    box2.resize(count);
+    std::uint64_t nearest = 0;
+    for (std::uint64_t i = 0; i < count; ++i)
+    {
+      box2[i] = BoxDistance2(p, this->Corners + 9 * std::size_t(this->Items[first + i]));
+      nearest = box2[i] < box2[nearest] ? i : nearest;
+    }
+    auto measure = [&](std::uint64_t i)
+    {
+      const double* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
+      const double d2 = PointTriangleDistance2(p, t, t + 3, t + 6);
+      if (d2 < best)
+      {
+        best = d2;
+        cutoff = this->Cutoff(best);
+      }
+    };
+    if (count == 0 || box2[nearest] > cutoff)
+    {
+      return;
+    }
+    measure(nearest);
+    for (std::uint64_t i = 0; i < count; ++i)
+    {
+      if (i != nearest && box2[i] <= cutoff)
+      {
+        measure(i);
+      }
+    }
+  }
+
+  /// The squared distance from p to the box of the triangle t: never above the distance to the
+  /// triangle itself.
+  static double BoxDistance2(const double p[3], const double* t)
+  {
+    double box2 = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double lo = std::min({ t[a], t[3 + a], t[6 + a] });
+      const double hi = std::max({ t[a], t[3 + a], t[6 + a] });
+      const double d = std::max(std::max(0.0, lo - p[a]), p[a] - hi); // no branches
+      box2 += d * d;
+    }
+    return box2;
+  }
+
+  /// The squared box distance beyond which a triangle cannot come nearer than `best` (squared):
+  /// sqrt(best) widened by a billionth of itself and by Slack, far more than the rounding of
+  /// either distance, so that a triangle skipped could never have given a smaller value.
+  double Cutoff(double best) const
+  {
+    const double reach = std::sqrt(best) * (1 + 1e-9) + this->Slack;
+    return reach * reach;
+  }
+
+  /// The bucket number of `key` (-1: no triangles there), through the memo.
+  std::int64_t Find(std::int64_t key, Memo& memo, bool home) const
+  {
+    // A home bucket first at or just after the last one (searches in HomeOrder come to their
+    // buckets in the keys' order): no lookup in the index.
+    const std::size_t window = std::min(this->Keys.size(), memo.Cursor + 3);
+    for (std::size_t b = memo.Cursor; home && b < window && this->Keys[b] <= key; ++b)
+    {
+      if (this->Keys[b] == key)
+      {
+        memo.Cursor = b;
+        return static_cast<std::int64_t>(b);
+      }
+    }
+    const std::size_t m = static_cast<std::size_t>(key) % Memo::Size;
+    if (memo.Keys[m] != key)
+    {
+      memo.Keys[m] = key;
+      memo.Found[m] = this->Index.Find(key);
+    }
+    if (home && memo.Found[m] >= 0)
+    {
+      memo.Cursor = static_cast<std::size_t>(memo.Found[m]);
+    }
+    return memo.Found[m];
   }
 
   const double* Corners;
   std::size_t Triangles;
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
+  double Slack = 0; // a distance far above the rounding of any coordinate (Cutoff)
   int Dims[3] = { 1, 1, 1 };
-  KeyIndex Index;                   // a bucket's key (Key) to its number b
+  std::vector<std::int64_t> Keys;   // bucket b's key (Key), increasing
+  KeyIndex Index;                   // a bucket's key to its number b
   std::vector<std::uint64_t> Start; // bucket b's items: [Start[b], Start[b + 1])
   std::vector<std::uint32_t> Items;
 };
