@@ -216,26 +216,17 @@ public:
     Parallel&& parallel = Parallel()) const
   {
     OverwriteVector<std::uint64_t> order(n); // filled whole below
-    int indexBits = 1;
-    while ((std::uint64_t(1) << indexBits) < n)
-    {
-      ++indexBits;
-    }
+    const int indexBits = BitsFor(n > 0 ? n - 1 : 0);
     indexMask = (std::uint64_t(1) << indexBits) - 1;
     const bool fits = this->KeyBits() + indexBits <= 64;
-    const std::int64_t chunks = static_cast<std::int64_t>((n + Chunk - 1) / Chunk);
-    parallel(chunks,
-      [&](std::int64_t c)
+    ForEachIndex(n, parallel,
+      [&](std::size_t i)
       {
-        const std::size_t last = std::min(n, (static_cast<std::size_t>(c) + 1) * Chunk);
-        for (std::size_t i = static_cast<std::size_t>(c) * Chunk; i < last; ++i)
-        {
-          const double* q = p + 3 * i;
-          const std::uint64_t key = fits ? static_cast<std::uint64_t>(this->Key(this->Cell(q[0], 0),
-                                             this->Cell(q[1], 1), this->Cell(q[2], 2)))
-                                         : 0;
-          order[i] = key << indexBits | i;
-        }
+        const double* q = p + 3 * i;
+        const std::uint64_t key = fits ? static_cast<std::uint64_t>(this->Key(this->Cell(q[0], 0),
+                                           this->Cell(q[1], 1), this->Cell(q[2], 2)))
+                                       : 0;
+        order[i] = key << indexBits | i;
       });
     if (fits)
     {
@@ -275,11 +266,7 @@ private:
       parallel);
     // A pair as one word (the bucket's key above the triangle's bits) where it fits, else as
     // two; sorted by key, stably, so each bucket's triangles stay in increasing order.
-    int triangleBits = 1;
-    while ((std::uint64_t(1) << triangleBits) < n)
-    {
-      ++triangleBits;
-    }
+    const int triangleBits = BitsFor(n - 1);
     const int keyBits = this->KeyBits();
     if (keyBits + triangleBits <= 64)
     {
@@ -376,16 +363,8 @@ private:
   void Group(std::size_t pairs, Parallel& parallel, KeyAt&& keyAt, TriangleAt&& triangleAt)
   {
     this->Items.resize(pairs);
+    ForEachIndex(pairs, parallel, [&](std::size_t i) { this->Items[i] = triangleAt(i); });
     const std::int64_t ranges = static_cast<std::int64_t>((pairs + Chunk - 1) / Chunk);
-    parallel(ranges,
-      [&](std::int64_t r)
-      {
-        const std::size_t last = std::min(pairs, (static_cast<std::size_t>(r) + 1) * Chunk);
-        for (std::size_t i = static_cast<std::size_t>(r) * Chunk; i < last; ++i)
-        {
-          this->Items[i] = triangleAt(i);
-        }
-      });
     // Each bucket's first pair: counted per range, then written at the range's place.
     auto starts = [&keyAt](std::int64_t i) { return i == 0 || keyAt(i) != keyAt(i - 1); };
     const std::vector<std::size_t> before =
@@ -405,16 +384,8 @@ private:
         }
       });
     this->Keys.resize(this->Start.size());
-    parallel(static_cast<std::int64_t>((this->Keys.size() + Chunk - 1) / Chunk),
-      [&](std::int64_t r)
-      {
-        const std::size_t last =
-          std::min(this->Keys.size(), (static_cast<std::size_t>(r) + 1) * Chunk);
-        for (std::size_t b = static_cast<std::size_t>(r) * Chunk; b < last; ++b)
-        {
-          this->Keys[b] = keyAt(this->Start[b]);
-        }
-      });
+    ForEachIndex(
+      this->Keys.size(), parallel, [&](std::size_t b) { this->Keys[b] = keyAt(this->Start[b]); });
     this->Index = KeyIndex(
       this->Keys.size(), [&](std::size_t b) { return this->Keys[b]; }, parallel);
     this->Start.push_back(pairs);
@@ -447,17 +418,37 @@ private:
     }
   }
 
-  /// The bits the largest bucket key needs.
-  int KeyBits() const
+  /// f(i) for each i in [0, n), in tasks of Chunk on `parallel`.
+  template <typename Parallel, typename F>
+  static void ForEachIndex(std::size_t n, Parallel& parallel, F&& f)
   {
-    const std::uint64_t lastKey = static_cast<std::uint64_t>(
-      this->Key(this->Dims[0] - 1, this->Dims[1] - 1, this->Dims[2] - 1));
+    parallel(static_cast<std::int64_t>((n + Chunk - 1) / Chunk),
+      [&](std::int64_t c)
+      {
+        const std::size_t last = std::min(n, (static_cast<std::size_t>(c) + 1) * Chunk);
+        for (std::size_t i = static_cast<std::size_t>(c) * Chunk; i < last; ++i)
+        {
+          f(i);
+        }
+      });
+  }
+
+  /// The bits (at least one) that hold every value up to `largest`.
+  static int BitsFor(std::uint64_t largest)
+  {
     int bits = 1;
-    while (bits < 64 && (lastKey >> bits) != 0)
+    while (bits < 64 && (largest >> bits) != 0)
     {
       ++bits;
     }
     return bits;
+  }
+
+  /// The bits the largest bucket key needs.
+  int KeyBits() const
+  {
+    return BitsFor(static_cast<std::uint64_t>(
+      this->Key(this->Dims[0] - 1, this->Dims[1] - 1, this->Dims[2] - 1)));
   }
 
   std::int64_t Key(int x, int y, int z) const
