@@ -151,6 +151,11 @@ public:
     std::int64_t Found[Size];
     std::vector<double> Boxes; // a bucket's triangles' box distances (VisitBucket)
     std::size_t Cursor = 0;    // the last home bucket found
+    // The last home bucket's triangles side by side (searches in HomeOrder come to the same home
+    // bucket one after another): their boxes by axis, Low[a][i] to High[a][i], and their corners
+    // (9 a triangle), read here instead of across the whole surface.
+    std::int64_t Home = -1;
+    std::vector<double> Low[3], High[3], Corners;
   };
 
   /// `corners`: 9 coordinates a triangle (a contiguous container of doubles: a std::vector with
@@ -203,7 +208,7 @@ public:
       {
         break;
       }
-      this->VisitShell(p, home, s, std::min(best, reach2), best, memo);
+      this->VisitShell(p, home, s, reach2, best, memo);
     }
     return best;
   }
@@ -456,9 +461,11 @@ private:
     return x + std::int64_t(this->Dims[0]) * (y + std::int64_t(this->Dims[1]) * z);
   }
 
-  /// The buckets at Chebyshev distance s from `home` whose box is within `bound` (squared) of p.
+  /// The buckets at Chebyshev distance s from `home` whose box is within `reach2` (squared) of p
+  /// and within the cutoff of the best so far (with its slack: a triangle counted in a bucket may
+  /// lie outside the bucket's box by a rounding of Cell).
   void VisitShell(
-    const double p[3], const int home[3], int s, double bound, double& best, Memo& memo) const
+    const double p[3], const int home[3], int s, double reach2, double& best, Memo& memo) const
   {
     double cutoff = this->Cutoff(best);
     for (int z = home[2] - s; z <= home[2] + s; ++z)
@@ -479,7 +486,7 @@ private:
             const double d = std::max(std::max(0.0, lo - p[a]), p[a] - (lo + this->Size));
             box2 += d * d;
           }
-          if (!inside || box2 > std::min(bound, best))
+          if (!inside || box2 > std::min(reach2, cutoff))
           {
             continue;
           }
@@ -488,28 +495,55 @@ private:
           {
             continue;
           }
-          this->VisitBucket(p, static_cast<std::size_t>(found), best, cutoff, memo);
+          this->VisitBucket(p, static_cast<std::size_t>(found), s == 0, best, cutoff, memo);
         }
       }
     }
   }
 
   /// The triangles of bucket b against p: the one whose box is nearest first (it gives a small
-  /// best, which cuts off most of the others), then those whose box is within the cutoff.
-  void VisitBucket(const double p[3], std::size_t b, double& best, double& cutoff, Memo& memo) const
+  /// best, which cuts off most of the others), then those whose box is within the cutoff. A home
+  /// bucket's triangles are read from the memo's copy (made when the home bucket changes).
+  void VisitBucket(
+    const double p[3], std::size_t b, bool home, double& best, double& cutoff, Memo& memo) const
   {
     const std::uint64_t first = this->Start[b], count = this->Start[b + 1] - first;
     std::vector<double>& box2 = memo.Boxes;
     box2.resize(count);
-    std::uint64_t nearest = 0;
-    for (std::uint64_t i = 0; i < count; ++i)
+    if (home && memo.Home != static_cast<std::int64_t>(b))
     {
-      box2[i] = BoxDistance2(p, this->Corners + 9 * std::size_t(this->Items[first + i]));
+      this->CopyBucket(b, memo);
+    }
+    if (home)
+    {
+      for (int a = 0; a < 3; ++a) // an axis at a time: loops the compiler vectorizes
+      {
+        const double* lo = memo.Low[a].data();
+        const double* hi = memo.High[a].data();
+        const double x = p[a];
+        for (std::uint64_t i = 0; i < count; ++i)
+        {
+          const double d = std::max(std::max(0.0, lo[i] - x), x - hi[i]);
+          box2[i] = (a == 0 ? 0.0 : box2[i]) + d * d;
+        }
+      }
+    }
+    else
+    {
+      for (std::uint64_t i = 0; i < count; ++i)
+      {
+        box2[i] = BoxDistance2(p, this->Corners + 9 * std::size_t(this->Items[first + i]));
+      }
+    }
+    std::uint64_t nearest = 0;
+    for (std::uint64_t i = 1; i < count; ++i)
+    {
       nearest = box2[i] < box2[nearest] ? i : nearest;
     }
     auto measure = [&](std::uint64_t i)
     {
-      const double* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
+      const double* t = home ? memo.Corners.data() + 9 * i
+                             : this->Corners + 9 * std::size_t(this->Items[first + i]);
       const double d2 = PointTriangleDistance2(p, t, t + 3, t + 6);
       if (d2 < best)
       {
@@ -527,6 +561,29 @@ private:
       if (i != nearest && box2[i] <= cutoff)
       {
         measure(i);
+      }
+    }
+  }
+
+  /// Bucket b's triangles into the memo, side by side: their boxes by axis and their corners.
+  void CopyBucket(std::size_t b, Memo& memo) const
+  {
+    const std::uint64_t first = this->Start[b], count = this->Start[b + 1] - first;
+    memo.Home = static_cast<std::int64_t>(b);
+    memo.Corners.resize(9 * count);
+    for (int a = 0; a < 3; ++a)
+    {
+      memo.Low[a].resize(count);
+      memo.High[a].resize(count);
+    }
+    for (std::uint64_t i = 0; i < count; ++i)
+    {
+      const double* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
+      std::copy(t, t + 9, memo.Corners.data() + 9 * i);
+      for (int a = 0; a < 3; ++a)
+      {
+        memo.Low[a][i] = std::min({ t[a], t[3 + a], t[6 + a] });
+        memo.High[a][i] = std::max({ t[a], t[3 + a], t[6 + a] });
       }
     }
   }
