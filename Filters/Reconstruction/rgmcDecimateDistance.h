@@ -47,11 +47,13 @@ namespace rgmc
 {
 constexpr int DistancePointsTag = 7411, DistanceTrianglesTag = 7413, DistanceCellsTag = 7415;
 
-/// One surface's part on this rank: its owned vertices and its triangles (canonical corners).
+/// One surface's part on this rank: its owned vertices and its triangles (canonical corners, as
+/// floats where the surface's points are floats: half the memory, the same values).
 struct DistanceSurface
 {
-  OverwriteVector<double> Points;    // 3 a vertex, each global vertex on one rank only
-  OverwriteVector<double> Triangles; // 9 a triangle (both sized, then filled on threads)
+  OverwriteVector<double> Points;        // 3 a vertex, each global vertex on one rank only
+  OverwriteVector<double> Triangles;     // 9 a triangle (sized, then filled on threads) or
+  OverwriteVector<float> FloatTriangles; // these, where the points are floats
   double Lo[3] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
     std::numeric_limits<double>::max() };
   double Hi[3] = { -std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
@@ -95,6 +97,25 @@ struct DistanceSurface
       }
       this->ReadTriangles(points, cells, first.data(), ids.data());
     }
+  }
+
+  /// f(triangles): the triangles' container, whichever type holds them.
+  template <typename F>
+  void WithTriangles(F&& f) const
+  {
+    if (this->FloatTriangles.empty())
+    {
+      f(this->Triangles);
+    }
+    else
+    {
+      f(this->FloatTriangles);
+    }
+  }
+
+  std::int64_t TriangleCount() const
+  {
+    return static_cast<std::int64_t>((this->Triangles.size() + this->FloatTriangles.size()) / 9);
   }
 
 private:
@@ -166,17 +187,31 @@ private:
   template <typename Offset, typename Id>
   void ReadTriangles(vtkPoints* points, vtkIdType cells, const Offset* offsets, const Id* ids)
   {
+    if (vtkAOSDataArrayTemplate<float>::FastDownCast(points->GetData()))
+    {
+      this->ReadTriangles(points, cells, offsets, ids, this->FloatTriangles);
+    }
+    else
+    {
+      this->ReadTriangles(points, cells, offsets, ids, this->Triangles);
+    }
+  }
+
+  template <typename Offset, typename Id, typename Out>
+  void ReadTriangles(
+    vtkPoints* points, vtkIdType cells, const Offset* offsets, const Id* ids, Out& triangles)
+  {
     std::vector<std::array<double, 6>> boxes(static_cast<std::size_t>(ChunksOf(cells, ReadChunk)));
     auto isTriangle = [offsets](vtkIdType c) { return offsets[c + 1] - offsets[c] == 3; };
     const std::vector<std::size_t> first = CountBefore(cells, ReadChunk, isTriangle);
-    this->Triangles.resize(9 * first.back());
+    triangles.resize(9 * first.back());
     ForEachChunk(cells, ReadChunk,
       [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
         std::array<double, 6>& box = boxes[static_cast<std::size_t>(c)];
         std::copy(this->Lo, this->Lo + 3, box.begin());
         std::copy(this->Hi, this->Hi + 3, box.begin() + 3);
-        double* t = this->Triangles.data() + 9 * first[static_cast<std::size_t>(c)];
+        auto* out = triangles.data() + 9 * first[static_cast<std::size_t>(c)];
         WithCoordinates(points,
           [&](auto&& point)
           {
@@ -186,6 +221,7 @@ private:
               {
                 continue;
               }
+              double t[9];
               for (int k = 0; k < 3; ++k)
               {
                 point(static_cast<vtkIdType>(ids[offsets[i] + k]), t + 3 * k);
@@ -195,8 +231,9 @@ private:
               {
                 box[k % 3] = std::min(box[k % 3], t[k]);
                 box[3 + k % 3] = std::max(box[3 + k % 3], t[k]);
+                out[k] = static_cast<typename Out::value_type>(t[k]); // floats stay exact
               }
-              t += 9;
+              out += 9;
             }
           });
       });
@@ -275,7 +312,7 @@ struct DistanceCells
 
 /// Measures the vertices `points` (at their cell's rank already) against `triangles`, within
 /// `limit`: adds the resolved ones to `into`, returns the others' coordinates.
-template <typename Points, typename Triangles> // contiguous containers of doubles
+template <typename Points, typename Triangles> // contiguous containers of doubles (or floats)
 std::vector<double> MeasureWithin(const Points& points, const Triangles& triangles, double bucket,
   double limit, DirectedDistance& into)
 {
@@ -296,7 +333,7 @@ std::vector<double> MeasureWithin(const Points& points, const Triangles& triangl
     [&](vtkIdType task, vtkIdType begin, vtkIdType end)
     {
       DirectedDistance& part = parts[task];
-      TriangleBuckets::Memo memo;
+      TriangleBucketsMemo memo;
       for (vtkIdType i = begin; i < end; ++i)
       {
         const double* p = points.data() + 3 * (order[static_cast<std::size_t>(i)] & indexMask);
@@ -336,8 +373,12 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
     TryLocally(problem, "measure the distances",
       [&]()
       {
-        MeasureWithin(
-          from.Points, to.Triangles, bucket, std::numeric_limits<double>::infinity(), result);
+        to.WithTriangles(
+          [&](const auto& triangles)
+          {
+            MeasureWithin(
+              from.Points, triangles, bucket, std::numeric_limits<double>::infinity(), result);
+          });
       });
     return ranks.Agree(problem.empty(), problem) && ReduceDirected(ranks, result, problem);
   }
@@ -370,26 +411,31 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
     const auto cellsOf = ranks.Exchange(told, everyone, DistanceCellsTag);
     std::vector<std::vector<vtkIdType>> sorted(cellsOf.begin(), cellsOf.end());
     std::vector<std::vector<double>> triangles(static_cast<std::size_t>(size));
-    for (std::size_t t = 0; t < to.Triangles.size(); t += 9)
-    {
-      const double* c = to.Triangles.data() + t;
-      const double lo[3] = { std::min({ c[0], c[3], c[6] }), std::min({ c[1], c[4], c[7] }),
-        std::min({ c[2], c[5], c[8] }) };
-      const double hi[3] = { std::max({ c[0], c[3], c[6] }), std::max({ c[1], c[4], c[7] }),
-        std::max({ c[2], c[5], c[8] }) };
-      std::vector<int> sentTo;
-      cells.ForCellsNear(lo, hi, all ? extent : r,
-        [&](std::int64_t cell)
+    to.WithTriangles(
+      [&](const auto& corners)
+      {
+        for (std::size_t t = 0; t < corners.size(); t += 9)
         {
-          const int owner = cells.RankOf(cell);
-          if (std::binary_search(sorted[owner].begin(), sorted[owner].end(), cell) &&
-            std::find(sentTo.begin(), sentTo.end(), owner) == sentTo.end())
-          {
-            sentTo.push_back(owner);
-            triangles[owner].insert(triangles[owner].end(), c, c + 9);
-          }
-        });
-    }
+          double c[9];
+          std::copy(corners.data() + t, corners.data() + t + 9, c);
+          const double lo[3] = { std::min({ c[0], c[3], c[6] }), std::min({ c[1], c[4], c[7] }),
+            std::min({ c[2], c[5], c[8] }) };
+          const double hi[3] = { std::max({ c[0], c[3], c[6] }), std::max({ c[1], c[4], c[7] }),
+            std::max({ c[2], c[5], c[8] }) };
+          std::vector<int> sentTo;
+          cells.ForCellsNear(lo, hi, all ? extent : r,
+            [&](std::int64_t cell)
+            {
+              const int owner = cells.RankOf(cell);
+              if (std::binary_search(sorted[owner].begin(), sorted[owner].end(), cell) &&
+                std::find(sentTo.begin(), sentTo.end(), owner) == sentTo.end())
+              {
+                sentTo.push_back(owner);
+                triangles[owner].insert(triangles[owner].end(), c, c + 9);
+              }
+            });
+        }
+      });
     std::vector<double> near;
     for (const auto& part : ranks.Exchange(triangles, everyone, DistanceTrianglesTag))
     {
@@ -459,9 +505,7 @@ inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* ou
     box[3 + k] = -std::max(a->Hi[k], b->Hi[k]);
   }
   ranks.AllReduce(box, global, 6, vtkCommunicator::MIN_OP, "the surfaces' box");
-  std::int64_t counts[2] = { static_cast<std::int64_t>(a->Triangles.size() / 9),
-    static_cast<std::int64_t>(b->Triangles.size() / 9) },
-               totals[2];
+  std::int64_t counts[2] = { a->TriangleCount(), b->TriangleCount() }, totals[2];
   ranks.AllReduce(counts, totals, 2, vtkCommunicator::SUM_OP, "the triangle counts");
   if (!ranks.Agree(true, problem))
   {

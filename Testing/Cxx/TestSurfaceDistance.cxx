@@ -6,7 +6,8 @@
 // and triangles whose box is beyond the best distance so far; a skip that lost the nearest
 // triangle would show here. Surfaces: random triangles, a fine surface against a coarse copy of
 // itself (a decimation's case: distances far below the triangles' size, many near ties), points
-// on the triangles (distance 0), degenerate and repeated triangles; searches within a limit.
+// on the triangles (distance 0), degenerate and repeated triangles; searches within a limit;
+// the corners kept as doubles and as floats.
 #include "rgmcCheck.h"
 #include "rgmcSurfaceDistance.h"
 #include "rgmcTaskOrders.h"
@@ -71,10 +72,28 @@ bool SameBits(double x, double y)
   return std::memcmp(&x, &y, sizeof x) == 0;
 }
 
-/// Every query against the brute force, for buckets of each size and each order of tasks.
+/// The triangles rounded to floats (canonical again), as doubles: what buckets of floats hold.
+std::vector<double> AsFloats(const std::vector<double>& triangles)
+{
+  std::vector<double> rounded(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); t += 9)
+  {
+    for (int k = 0; k < 9; ++k)
+    {
+      rounded[t + k] = static_cast<float>(triangles[t + k]);
+    }
+    rgmc::CanonicalTriangle(rounded.data() + t);
+  }
+  return rounded;
+}
+
+/// Every query against the brute force, for buckets of each size and each order of tasks, the
+/// corners kept as T (double, or float: `triangles` then hold floats' values).
+template <typename T>
 void Check(const std::vector<double>& triangles, const std::vector<double>& points,
   const std::vector<double>& sizes, const std::string& what)
 {
+  const std::vector<T> stored(triangles.begin(), triangles.end());
   std::vector<double> expected(points.size() / 3);
   for (std::size_t q = 0; q < expected.size(); ++q)
   {
@@ -87,8 +106,8 @@ void Check(const std::vector<double>& triangles, const std::vector<double>& poin
       auto parallel = mode == 0
         ? rgmc_test::TasksInOrder
         : (mode == 1 ? rgmc_test::TasksReversed : rgmc_test::TasksOnThreads);
-      const rgmc::TriangleBuckets buckets(triangles, size, parallel);
-      rgmc::TriangleBuckets::Memo memo;
+      const rgmc::TriangleBuckets buckets(stored, size, parallel);
+      rgmc::TriangleBucketsMemo memo;
       std::size_t wrong = 0, wrongAlone = 0, wrongLimited = 0;
       for (std::size_t q = 0; q < expected.size(); ++q)
       {
@@ -110,7 +129,7 @@ void Check(const std::vector<double>& triangles, const std::vector<double>& poin
       std::uint64_t mask = 0;
       const auto order = buckets.HomeOrder(points.data(), expected.size(), mask, parallel);
       std::vector<int> seen(expected.size(), 0);
-      rgmc::TriangleBuckets::Memo ordered;
+      rgmc::TriangleBucketsMemo ordered;
       for (const std::uint64_t word : order)
       {
         const std::size_t q = static_cast<std::size_t>(word & mask);
@@ -123,9 +142,10 @@ void Check(const std::vector<double>& triangles, const std::vector<double>& poin
       RGMC_CHECK(order.size() == expected.size(),
         what << ": HomeOrder has " << order.size() << " points, not " << expected.size());
       RGMC_CHECK(wrong == 0 && wrongAlone == 0 && wrongLimited == 0,
-        what << ", buckets of " << size << ", tasks " << mode << ": " << wrong << " of "
-             << expected.size() << " searches (" << wrongAlone << " without a memo, "
-             << wrongLimited << " within a limit) not the brute force's to the bit");
+        what << (sizeof(T) == 4 ? " (floats)" : "") << ", buckets of " << size << ", tasks " << mode
+             << ": " << wrong << " of " << expected.size() << " searches (" << wrongAlone
+             << " without a memo, " << wrongLimited
+             << " within a limit) not the brute force's to the bit");
     }
   }
 }
@@ -158,7 +178,7 @@ int main()
         points.push_back(130 * unit(random) - 15);
       }
     }
-    Check(triangles, points, { 0.5, 4, 40 }, "random triangles");
+    Check<double>(triangles, points, { 0.5, 4, 40 }, "random triangles");
   }
   {
     // A fine surface and a coarse copy of it (a decimation), far from the origin, each
@@ -169,8 +189,13 @@ int main()
     {
       fineCorners[k] += 1e-3 * (unit(random) - 0.5);
     }
-    Check(coarse, fineCorners, { 0.4, 1.3, 5 }, "fine vertices to a coarse copy");
-    Check(fine, coarseCorners, { 0.4, 1.3, 5 }, "coarse vertices to the fine surface");
+    Check<double>(coarse, fineCorners, { 0.4, 1.3, 5 }, "fine vertices to a coarse copy");
+    Check<double>(fine, coarseCorners, { 0.4, 1.3, 5 }, "coarse vertices to the fine surface");
+    // As floats (a float surface's triangles are kept so), far from the origin: ties and
+    // roundings near the float's precision.
+    Check<float>(AsFloats(coarse), fineCorners, { 0.4, 1.3, 5 }, "fine vertices to a coarse copy");
+    Check<float>(
+      AsFloats(fine), coarseCorners, { 0.4, 1.3, 5 }, "coarse vertices to the fine surface");
   }
   {
     // Degenerate triangles (a point, a segment) and a triangle repeated, points on them.
@@ -179,7 +204,7 @@ int main()
       0, 0, 0, 0, 3, 0, 0, 0, 3, 0, 0, 0, 0, 3, 0, 0, 0, 3 };    /* twice */
     const std::vector<double> points = { 1, 1, 1, 3, 0, 0, 0, 1, 1, 0.5, 0.5, 0.5, -1, -1, -1, 5, 5,
       5 };
-    Check(triangles, points, { 0.25, 1, 10 }, "degenerate and repeated triangles");
+    Check<double>(triangles, points, { 0.25, 1, 10 }, "degenerate and repeated triangles");
   }
   return rgmc_test::Result("TestSurfaceDistance");
 }

@@ -123,6 +123,30 @@ inline void CanonicalTriangle(double t[9])
   }
 }
 
+/// The buckets a search looked up lately, by key (direct-mapped): searches from nearby points,
+/// one after another, look up the same buckets, and each lookup in the index is a cache miss
+/// (its slots are scattered on purpose). A memo per thread of searches; what a search finds
+/// never depends on it. The same for buckets of any coordinate type.
+class TriangleBucketsMemo
+{
+public:
+  TriangleBucketsMemo() { std::fill(this->Keys, this->Keys + Size, std::int64_t(-1)); }
+
+private:
+  template <typename>
+  friend class TriangleBuckets;
+  static constexpr std::size_t Size = 512;
+  std::int64_t Keys[Size];
+  std::int64_t Found[Size];
+  std::vector<double> Boxes; // a bucket's triangles' box distances (VisitBucket)
+  std::size_t Cursor = 0;    // the last home bucket found
+  // The last home bucket's triangles side by side (searches in HomeOrder come to the same home
+  // bucket one after another): their boxes by axis, Low[a][i] to High[a][i], and their corners
+  // (9 a triangle), read here instead of across the whole surface.
+  std::int64_t Home = -1;
+  std::vector<double> Low[3], High[3], Corners;
+};
+
 /// Triangles (9 coordinates each, canonical) in a grid of cubic buckets: each triangle is in
 /// every bucket its bounding box overlaps. Built on tasks (`parallel`, as the radix sort's):
 /// the (bucket, triangle) pairs of fixed chunks of triangles, sorted by bucket; a bucket's
@@ -131,35 +155,17 @@ inline void CanonicalTriangle(double t[9])
 /// around its point and skips a bucket, or a triangle, whose box is farther than the best
 /// distance so far (in each bucket the triangle whose box is nearest is measured first); what
 /// it returns is the minimum over all triangles within its limit, to the bit (TestSurfaceDistance
-/// holds it to the brute force).
+/// holds it to the brute force). The corners are kept as `T` (float or double: a float surface's
+/// triangles in half the memory) and measured as doubles, which hold any float exactly.
+template <typename T>
 class TriangleBuckets
 {
 public:
-  /// The buckets a search looked up lately, by key (direct-mapped): searches from nearby points,
-  /// one after another, look up the same buckets, and each lookup in the index is a cache miss
-  /// (its slots are scattered on purpose). A memo per thread of searches; what a search finds
-  /// never depends on it.
-  class Memo
-  {
-  public:
-    Memo() { std::fill(this->Keys, this->Keys + Size, std::int64_t(-1)); }
+  /// The buckets a search looked up lately (TriangleBucketsMemo).
+  using Memo = TriangleBucketsMemo;
 
-  private:
-    friend class TriangleBuckets;
-    static constexpr std::size_t Size = 512;
-    std::int64_t Keys[Size];
-    std::int64_t Found[Size];
-    std::vector<double> Boxes; // a bucket's triangles' box distances (VisitBucket)
-    std::size_t Cursor = 0;    // the last home bucket found
-    // The last home bucket's triangles side by side (searches in HomeOrder come to the same home
-    // bucket one after another): their boxes by axis, Low[a][i] to High[a][i], and their corners
-    // (9 a triangle), read here instead of across the whole surface.
-    std::int64_t Home = -1;
-    std::vector<double> Low[3], High[3], Corners;
-  };
-
-  /// `corners`: 9 coordinates a triangle (a contiguous container of doubles: a std::vector with
-  /// any allocator), kept by reference; `size`: the buckets' edge.
+  /// `corners`: 9 coordinates a triangle (a contiguous container of T: a std::vector with any
+  /// allocator), kept by reference; `size`: the buckets' edge.
   template <typename Container, typename Parallel = SerialTasks>
   TriangleBuckets(const Container& corners, double size, Parallel&& parallel = Parallel())
     : Corners(corners.data())
@@ -315,8 +321,8 @@ private:
         const std::size_t last = std::min(n, (static_cast<std::size_t>(c) + 1) * Chunk);
         for (std::size_t k = 9 * Chunk * static_cast<std::size_t>(c); k < 9 * last; ++k)
         {
-          box[k % 3] = std::min(box[k % 3], this->Corners[k]);
-          box[3 + k % 3] = std::max(box[3 + k % 3], this->Corners[k]);
+          box[k % 3] = std::min(box[k % 3], static_cast<double>(this->Corners[k]));
+          box[3 + k % 3] = std::max(box[3 + k % 3], static_cast<double>(this->Corners[k]));
         }
       });
     double lo[3] = { inf, inf, inf }, hi[3] = { -inf, -inf, -inf };
@@ -403,7 +409,7 @@ private:
     const std::size_t n = this->Triangles;
     for (std::size_t t = c * Chunk; t < std::min(n, (c + 1) * Chunk); ++t)
     {
-      const double* p = this->Corners + 9 * t;
+      const T* p = this->Corners + 9 * t;
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a)
       {
@@ -542,8 +548,13 @@ private:
     }
     auto measure = [&](std::uint64_t i)
     {
-      const double* t = home ? memo.Corners.data() + 9 * i
-                             : this->Corners + 9 * std::size_t(this->Items[first + i]);
+      double corners[9];
+      const double* t = home ? memo.Corners.data() + 9 * i : corners;
+      if (!home)
+      {
+        const T* c = this->Corners + 9 * std::size_t(this->Items[first + i]);
+        std::copy(c, c + 9, corners);
+      }
       const double d2 = PointTriangleDistance2(p, t, t + 3, t + 6);
       if (d2 < best)
       {
@@ -578,7 +589,7 @@ private:
     }
     for (std::uint64_t i = 0; i < count; ++i)
     {
-      const double* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
+      const T* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
       std::copy(t, t + 9, memo.Corners.data() + 9 * i);
       for (int a = 0; a < 3; ++a)
       {
@@ -590,7 +601,7 @@ private:
 
   /// The squared distance from p to the box of the triangle t: never above the distance to the
   /// triangle itself.
-  static double BoxDistance2(const double p[3], const double* t)
+  static double BoxDistance2(const double p[3], const T* t)
   {
     double box2 = 0;
     for (int a = 0; a < 3; ++a)
@@ -639,7 +650,7 @@ private:
     return memo.Found[m];
   }
 
-  const double* Corners;
+  const T* Corners;
   std::size_t Triangles;
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
@@ -650,6 +661,11 @@ private:
   std::vector<std::uint64_t> Start; // bucket b's items: [Start[b], Start[b + 1])
   std::vector<std::uint32_t> Items;
 };
+
+/// Buckets of the corners' type: TriangleBuckets buckets(corners, size, parallel).
+template <typename Container, typename... Parallel>
+TriangleBuckets(const Container&, double, Parallel&&...)
+  -> TriangleBuckets<typename Container::value_type>;
 
 } // namespace rgmc
 
