@@ -251,9 +251,12 @@ private:
   /// Triangles a task of the build (fixed: the chunks never depend on the threads).
   static constexpr std::size_t Chunk = 16384;
 
+  /// The bucket along axis a of x (clamped to the grid): monotone in x, as every search needs; by
+  /// the edge's inverse, so a coordinate may land a rounding outside its bucket's box (the
+  /// searches' Slack covers far more).
   int Cell(double x, int a) const
   {
-    const double c = std::floor((x - this->Origin[a]) / this->Size);
+    const double c = std::floor((x - this->Origin[a]) * this->Inverse);
     return static_cast<int>(std::max(0.0, std::min<double>(c, this->Dims[a] - 1)));
   }
 
@@ -346,6 +349,7 @@ private:
     {
       this->Size = 1;
     }
+    this->Inverse = 1 / this->Size;
     double magnitude = 0;
     for (int a = 0; a < 3; ++a)
     {
@@ -654,7 +658,8 @@ private:
   std::size_t Triangles;
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
-  double Slack = 0; // a distance far above the rounding of any coordinate (Cutoff)
+  double Inverse = 1; // 1 / Size
+  double Slack = 0;   // a distance far above the rounding of any coordinate (Cutoff)
   int Dims[3] = { 1, 1, 1 };
   std::vector<std::int64_t> Keys;   // bucket b's key (Key), increasing
   KeyIndex Index;                   // a bucket's key to its number b
