@@ -416,12 +416,9 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
       {
         for (std::size_t t = 0; t < corners.size(); t += 9)
         {
-          double c[9];
-          std::copy(corners.data() + t, corners.data() + t + 9, c);
-          const double lo[3] = { std::min({ c[0], c[3], c[6] }), std::min({ c[1], c[4], c[7] }),
-            std::min({ c[2], c[5], c[8] }) };
-          const double hi[3] = { std::max({ c[0], c[3], c[6] }), std::max({ c[1], c[4], c[7] }),
-            std::max({ c[2], c[5], c[8] }) };
+          const auto* c = corners.data() + t;
+          double lo[3], hi[3];
+          TriangleBox(c, lo, hi);
           std::vector<int> sentTo;
           cells.ForCellsNear(lo, hi, all ? extent : r,
             [&](std::int64_t cell)

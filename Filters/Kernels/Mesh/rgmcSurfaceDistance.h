@@ -123,6 +123,17 @@ inline void CanonicalTriangle(double t[9])
   }
 }
 
+/// The box [lo, hi] of the triangle t (9 coordinates, floats or doubles), as doubles.
+template <typename T>
+void TriangleBox(const T* t, double lo[3], double hi[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = std::min({ t[a], t[3 + a], t[6 + a] });
+    hi[a] = std::max({ t[a], t[3 + a], t[6 + a] });
+  }
+}
+
 /// The buckets a search looked up lately, by key (direct-mapped): searches from nearby points,
 /// one after another, look up the same buckets, and each lookup in the index is a cache miss
 /// (its slots are scattered on purpose). A memo per thread of searches; what a search finds
@@ -413,12 +424,13 @@ private:
     const std::size_t n = this->Triangles;
     for (std::size_t t = c * Chunk; t < std::min(n, (c + 1) * Chunk); ++t)
     {
-      const T* p = this->Corners + 9 * t;
+      double box[2][3];
+      TriangleBox(this->Corners + 9 * t, box[0], box[1]);
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a)
       {
-        lo[a] = this->Cell(std::min({ p[a], p[3 + a], p[6 + a] }), a);
-        hi[a] = this->Cell(std::max({ p[a], p[3 + a], p[6 + a] }), a);
+        lo[a] = this->Cell(box[0][a], a);
+        hi[a] = this->Cell(box[1][a], a);
       }
       for (int z = lo[2]; z <= hi[2]; ++z)
       {
@@ -595,10 +607,12 @@ private:
     {
       const T* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
       std::copy(t, t + 9, memo.Corners.data() + 9 * i);
+      double lo[3], hi[3];
+      TriangleBox(t, lo, hi);
       for (int a = 0; a < 3; ++a)
       {
-        memo.Low[a][i] = std::min({ t[a], t[3 + a], t[6 + a] });
-        memo.High[a][i] = std::max({ t[a], t[3 + a], t[6 + a] });
+        memo.Low[a][i] = lo[a];
+        memo.High[a][i] = hi[a];
       }
     }
   }
@@ -607,12 +621,12 @@ private:
   /// triangle itself.
   static double BoxDistance2(const double p[3], const T* t)
   {
+    double lo[3], hi[3];
+    TriangleBox(t, lo, hi);
     double box2 = 0;
     for (int a = 0; a < 3; ++a)
     {
-      const double lo = std::min({ t[a], t[3 + a], t[6 + a] });
-      const double hi = std::max({ t[a], t[3 + a], t[6 + a] });
-      const double d = std::max(std::max(0.0, lo - p[a]), p[a] - hi); // no branches
+      const double d = std::max(std::max(0.0, lo[a] - p[a]), p[a] - hi[a]); // no branches
       box2 += d * d;
     }
     return box2;
