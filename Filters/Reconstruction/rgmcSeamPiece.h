@@ -5,7 +5,9 @@
 #include "rgmcBuffer.h"
 #include "rgmcGrid.h"
 #include "rgmcSeamNumbering.h"
+#include "rgmcTasks.h"
 #include "vtkRGCollective.h"
+#include "vtkRGParallel.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
@@ -149,9 +151,17 @@ struct SeamPiece
   }
 
   /// The triangle corners (3 t + k, of type I as the connectivity's entries are) at each vertex,
-  /// in compressed rows.
+  /// in compressed rows, each in increasing order: on threads where the vertices follow the
+  /// triangles (rgmc::GroupByKey), else in one pass.
   void CornersAround(std::vector<vtkIdType>& offsets, rgmc::LargeVector<I>& corners) const
   {
+    if (!rgmc::SingleThreaded() &&
+      rgmc::GroupByKey(
+        3 * this->NumTriangles, this->NumVertices,
+        [this](std::int64_t c) { return this->Triangles[c]; }, offsets, corners, rgmc::Tasks()))
+    {
+      return;
+    }
     offsets.assign(static_cast<std::size_t>(this->NumVertices) + 1, 0);
     for (vtkIdType c = 0; c < 3 * this->NumTriangles; ++c)
     {

@@ -2,7 +2,8 @@
 // come out as std::sort on the pairs gives them, for keys that differ in few or many bytes, with
 // many equal keys, and for keys whose top bits are set (unsigned order); the packed sort runs
 // exactly when every key fits above the indices' bits; on tasks (ranges of 65 536 values) run
-// in reverse order and on threads, the same, in a vector that leaves new values unset too.
+// in reverse order and on threads, the same, in a vector that leaves new values unset too. And
+// rgmc::GroupByKey (Seam Repair's corners by vertex on threads) against a counting pass in order.
 #include "rgmcCheck.h"
 #include "rgmcRadixSort.h"
 #include "rgmcTaskOrders.h"
@@ -80,6 +81,62 @@ void Check(const std::vector<std::uint64_t>& keys, const char* what)
   }
 }
 
+/// rgmc::GroupByKey against one counting pass in order: the same offsets and items, on tasks in
+/// order, reversed and on threads; or a refusal, with nothing changed, exactly when the chunks'
+/// ranges of keys (65 536 indices a chunk) add up to more than 2 (n + keys).
+void CheckGroups(const std::vector<int>& keyOf, std::int64_t keys, const char* what)
+{
+  const std::int64_t n = static_cast<std::int64_t>(keyOf.size());
+  std::vector<std::int64_t> offsets(static_cast<std::size_t>(keys) + 1, 0);
+  for (int k : keyOf)
+  {
+    ++offsets[static_cast<std::size_t>(k) + 1];
+  }
+  for (std::int64_t k = 0; k < keys; ++k)
+  {
+    offsets[k + 1] += offsets[k];
+  }
+  std::vector<std::int64_t> place(offsets.begin(), offsets.end() - 1);
+  std::vector<std::int32_t> items(keyOf.size());
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    items[static_cast<std::size_t>(place[keyOf[i]]++)] = static_cast<std::int32_t>(i);
+  }
+  std::int64_t ranges = 0;
+  for (std::int64_t c = 0; c < n; c += 65536)
+  {
+    const auto chunk =
+      std::minmax_element(keyOf.begin() + c, keyOf.begin() + std::min(n, c + 65536));
+    ranges += *chunk.second - *chunk.first + 1;
+  }
+  const bool local = ranges <= 2 * (n + keys);
+  for (int mode = 0; mode < 3; ++mode)
+  {
+    auto parallel = mode == 0 ? rgmc_test::TasksInOrder
+      : mode == 1             ? rgmc_test::TasksReversed
+                              : rgmc_test::TasksOnThreads;
+    std::vector<std::int64_t> gotOffsets{ -1 };
+    rgmc::LargeVector<std::int32_t> gotItems(3, -1);
+    const bool done = rgmc::GroupByKey(
+      n, keys, [&keyOf](std::int64_t i) { return keyOf[static_cast<std::size_t>(i)]; }, gotOffsets,
+      gotItems, parallel);
+    RGMC_CHECK(done == local,
+      what << ", mode " << mode << ": ranges " << ranges << " of " << 2 * (n + keys)
+           << " allowed, but " << (done ? "grouped" : "refused"));
+    if (done)
+    {
+      RGMC_CHECK(gotOffsets == offsets &&
+          std::equal(gotItems.begin(), gotItems.end(), items.begin(), items.end()),
+        what << ", mode " << mode << ": " << n << " indices, " << keys << " keys");
+    }
+    else
+    {
+      RGMC_CHECK(gotOffsets.size() == 1 && gotItems.size() == 3,
+        what << ", mode " << mode << ": refused, yet the outputs changed");
+    }
+  }
+}
+
 static_assert(rgmc::LeavesValuesUnset<rgmc::OverwriteVector<Record>>::value &&
     !rgmc::LeavesValuesUnset<rgmc::LargeVector<Record>>::value &&
     !rgmc::LeavesValuesUnset<std::vector<Record>>::value,
@@ -141,5 +198,41 @@ int main()
     }
     Check(keys, "one varying byte");
   }
+  // Grouping by key: keys that follow the indices as a mesh's vertices follow its corners (some
+  // keys without an index, chunk boundaries in every place), and keys scattered at random.
+  for (std::int64_t n : { 0, 1, 5, 65535, 65536, 65537, 400000 })
+  {
+    const std::int64_t keys = n / 6 + 50;
+    std::vector<int> keyOf(static_cast<std::size_t>(n));
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      const std::int64_t k = i / 6 + static_cast<std::int64_t>(random() % 2001) - 1000;
+      keyOf[i] = static_cast<int>(std::max<std::int64_t>(0, std::min(keys - 1, k)));
+    }
+    CheckGroups(keyOf, keys, "keys that follow the indices");
+    for (int& k : keyOf)
+    {
+      k = static_cast<int>(random() % static_cast<std::uint64_t>(keys));
+    }
+    CheckGroups(keyOf, keys, "scattered keys");
+  }
+  // As many keys as indices, scattered: refused (5 chunks over 300 000 keys each).
+  std::vector<int> scattered(300000);
+  for (int& k : scattered)
+  {
+    k = static_cast<int>(random() % 300000);
+  }
+  scattered[0] = 0;
+  scattered[1] = 299999;
+  CheckGroups(scattered, 300000, "as many keys as indices, scattered");
+  // A few far keys among local ones: grouped while the ranges allow.
+  std::vector<int> keyOf(300000);
+  for (std::size_t i = 0; i < keyOf.size(); ++i)
+  {
+    keyOf[i] = static_cast<int>(i / 3);
+  }
+  keyOf[70000] = 99999;
+  keyOf[200000] = 0;
+  CheckGroups(keyOf, 100000, "a few far keys");
   return rgmc_test::Result("TestRadixSort");
 }

@@ -6,6 +6,8 @@
 #ifndef rgmcTasks_h
 #define rgmcTasks_h
 
+#include "rgmcBuffer.h"
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -95,6 +97,111 @@ std::vector<std::size_t> CountBefore(
     parallel);
   places.Places.push_back(places.End[0]);
   return std::move(places.Places);
+}
+
+/// Groups the indices 0 <= i < n by their key keyAt(i), in [0, keys): on return, key k's indices
+/// are items[offsets[k]] .. items[offsets[k + 1] - 1], in increasing order (offsets: keys + 1
+/// values), exactly as one counting pass in order gives them, on any threads. For keys that
+/// follow the indices (the corners of a mesh by vertex, its vertices numbered as its triangles
+/// come): each chunk of indices counts its keys over the range of keys it meets, each key's
+/// counts are then summed chunk after chunk (tasks over blocks of keys), and each chunk places
+/// its indices after those of the chunks before it. Returns false, having changed nothing, when
+/// the chunks' ranges of keys add up to more than 2 (n + keys) (scattered keys: the caller
+/// takes one pass in order).
+template <typename KeyAt, typename Offsets, typename Items, typename Parallel>
+bool GroupByKey(std::int64_t n, std::int64_t keys, KeyAt&& keyAt, Offsets& offsets, Items& items,
+  Parallel&& parallel)
+{
+  constexpr std::int64_t chunk = 65536, keyBlock = 65536;
+  const std::int64_t chunks = ChunksOf(n, chunk), blocks = ChunksOf(keys, keyBlock);
+  // Each chunk's keys [low, high), then its counts at base[c] .. base[c + 1].
+  std::vector<std::int64_t> low(static_cast<std::size_t>(chunks), 0), high(low), base(low);
+  parallel(chunks,
+    [&](std::int64_t c)
+    {
+      std::int64_t lo = keys, hi = 0;
+      for (std::int64_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+      {
+        const std::int64_t k = static_cast<std::int64_t>(keyAt(i));
+        lo = std::min(lo, k);
+        hi = std::max(hi, k + 1);
+      }
+      low[c] = lo;
+      high[c] = std::max(lo, hi);
+    });
+  std::int64_t total = 0;
+  for (std::int64_t c = 0; c < chunks; ++c)
+  {
+    base[c] = total;
+    total += high[c] - low[c];
+  }
+  if (total > 2 * (n + keys))
+  {
+    return false;
+  }
+  OverwriteVector<std::int64_t> counts(static_cast<std::size_t>(total)); // zeroed by each chunk
+  parallel(chunks,
+    [&](std::int64_t c)
+    {
+      std::int64_t* count = counts.data() + base[c] - low[c];
+      std::fill(count + low[c], count + high[c], std::int64_t(0));
+      for (std::int64_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+      {
+        ++count[static_cast<std::int64_t>(keyAt(i))];
+      }
+    });
+  // Per block of keys: each chunk's count becomes its first place among the key's indices, and
+  // offsets[k + 1] the key's size; then the sizes summed, blocks first.
+  offsets.assign(static_cast<std::size_t>(keys) + 1, 0);
+  std::vector<std::int64_t> blockSize(static_cast<std::size_t>(blocks) + 1, 0);
+  parallel(blocks,
+    [&](std::int64_t b)
+    {
+      const std::int64_t first = b * keyBlock, last = std::min(keys, first + keyBlock);
+      for (std::int64_t c = 0; c < chunks; ++c)
+      {
+        std::int64_t* count = counts.data() + base[c] - low[c];
+        for (std::int64_t k = std::max(first, low[c]); k < std::min(last, high[c]); ++k)
+        {
+          offsets[k + 1] += std::exchange(count[k], offsets[k + 1]);
+        }
+      }
+      for (std::int64_t k = first; k < last; ++k)
+      {
+        blockSize[b + 1] += offsets[k + 1];
+      }
+    });
+  for (std::int64_t b = 0; b < blocks; ++b)
+  {
+    blockSize[b + 1] += blockSize[b];
+  }
+  parallel(blocks,
+    [&](std::int64_t b)
+    {
+      const std::int64_t first = b * keyBlock, last = std::min(keys, first + keyBlock);
+      std::int64_t at = blockSize[b];
+      for (std::int64_t k = first; k < last; ++k)
+      {
+        at += offsets[k + 1];
+        offsets[k + 1] = at;
+      }
+    });
+  items.resize(static_cast<std::size_t>(n));
+  parallel(chunks,
+    [&](std::int64_t c)
+    {
+      std::int64_t* place = counts.data() + base[c] - low[c];
+      for (std::int64_t k = low[c]; k < high[c]; ++k)
+      {
+        place[k] += offsets[k];
+      }
+      for (std::int64_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+      {
+        items[static_cast<std::size_t>(place[static_cast<std::int64_t>(keyAt(i))]++)] =
+          static_cast<typename Items::value_type>(i);
+      }
+    });
+  return true;
 }
 
 } // namespace rgmc
