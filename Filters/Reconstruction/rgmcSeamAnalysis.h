@@ -64,6 +64,7 @@ public:
     if (!this->AllRanks.Step("list the edges at the seams", problem,
           [&]()
           {
+            rgmc::SpanMark("seam analysis: corners");
             this->CornersAround(this->CornerOffsets, this->Corners);
             this->ListSeamEdges(toOwners);
           }))
@@ -75,6 +76,7 @@ public:
     if (!this->AllRanks.Step("make the smoothing stencils", problem,
           [&]()
           {
+            rgmc::SpanMark("seam analysis: stencils");
             this->AssembleNeighbourhoods(received, stencils, checks);
             this->NumberRemoteNeighbours();
             this->ListSharedVertices();
@@ -219,7 +221,7 @@ private:
   {
     std::vector<vtkIdType> Vertices; // in order; -1 - v for a vertex AddVertex takes
     std::vector<vtkIdType> Ends;     // row ends in Neighbours, per manifold vertex
-    rgmc::LargeVector<I> Neighbours;
+    rgmc::OverwriteVector<I> Neighbours;
     vtkIdType Edges = 0;
   };
 
@@ -339,7 +341,7 @@ private:
   /// counted in `edges` and its row appended to `row` (when stencils are made). Reads only:
   /// threads may call it at once, each with its own `ends`.
   bool ManifoldRow(vtkIdType v, bool stencils, std::vector<std::pair<vtkIdType, vtkIdType>>& ends,
-    rgmc::LargeVector<I>& row, vtkIdType& edges) const
+    rgmc::OverwriteVector<I>& row, vtkIdType& edges) const
   {
     if (this->OrientedFanRow(v, stencils, row, edges))
     {
@@ -373,7 +375,8 @@ private:
   /// test), and the row is the next corners ranked by gid. Returns false, having changed
   /// nothing, when this does not hold (ManifoldRow then decides by sorting the ends). No
   /// branch on the gids' order: the ranks are counted.
-  bool OrientedFanRow(vtkIdType v, bool stencils, rgmc::LargeVector<I>& row, vtkIdType& edges) const
+  bool OrientedFanRow(
+    vtkIdType v, bool stencils, rgmc::OverwriteVector<I>& row, vtkIdType& edges) const
   {
     constexpr int MaxFan = 12;
     const vtkIdType first = this->CornerOffsets[v];
@@ -610,10 +613,20 @@ private:
       throw std::length_error("more vertices and neighbours held elsewhere than the "
                               "connectivity's index type can number in one piece");
     }
-    for (I& s : this->Stencil.Neighbours)
-    {
-      s = s < 0 ? static_cast<I>(this->NumVertices + slotOf[-1 - static_cast<vtkIdType>(s)]) : s;
-    }
+    // The remote neighbours' entries (negative) become their slots, on threads; none when no
+    // neighbour is held elsewhere.
+    rgmc::OverwriteVector<I>& neighbours = this->Stencil.Neighbours;
+    rgmc::ForEachChunk(pending.empty() ? 0 : static_cast<vtkIdType>(neighbours.size()),
+      rgmc::ElementChunk,
+      [&](vtkIdType, vtkIdType first, vtkIdType last)
+      {
+        for (vtkIdType i = first; i < last; ++i)
+        {
+          const I s = neighbours[i];
+          neighbours[i] =
+            s < 0 ? static_cast<I>(this->NumVertices + slotOf[-1 - static_cast<vtkIdType>(s)]) : s;
+        }
+      });
     std::vector<Pending>().swap(this->PendingRemote);
   }
 

@@ -39,12 +39,12 @@ public:
   /// three agreements; the output's array "Normals", or null on failure.
   vtkSmartPointer<vtkFloatArray> Normals(std::string& problem)
   {
-    rgmc::LargeVector<double> sums;
+    rgmc::OverwriteVector<double> sums; // every vertex's written by SumOwnTerms
     std::vector<std::vector<vtkIdType>> toOwners(this->AllRanks.Size);
     if (!this->AllRanks.Step("compute normals", problem,
           [&]()
           {
-            sums.assign(3 * this->NumVertices, 0.0);
+            sums.resize(static_cast<std::size_t>(3 * this->NumVertices));
             if (this->CornerOffsets.empty())
             {
               this->CornersAround(this->CornerOffsets, this->Corners);
@@ -65,7 +65,7 @@ public:
     {
       return nullptr;
     }
-    rgmc::LargeVector<double>().swap(this->TriangleCross);
+    rgmc::OverwriteVector<double>().swap(this->TriangleCross);
     this->Update(sums.data(), NormalBackTag);
     auto normals = vtkSmartPointer<vtkFloatArray>::New();
     if (!this->AllRanks.Step("compute normals", problem,
@@ -206,7 +206,7 @@ private:
   /// Each vertex's sum of this rank's terms, on threads (each range with its own list), in
   /// SumTerms' order, from TriangleAtVertex. Owned shared vertices are summed again with every
   /// holder's terms (SumSharedTerms); the other shared ones get their owner's.
-  void SumOwnTerms(rgmc::LargeVector<double>& sums) const
+  void SumOwnTerms(rgmc::OverwriteVector<double>& sums) const
   {
     const std::vector<vtkIdType>& gid = this->Numbering.Gid;
     rgmc::ParallelFor(this->NumVertices, RowGrain,
@@ -245,7 +245,7 @@ private:
 
   /// Owned shared vertices: their own terms and every holder's, in the same order.
   void SumSharedTerms(
-    const std::vector<std::vector<vtkIdType>>& received, rgmc::LargeVector<double>& sums) const
+    const std::vector<std::vector<vtkIdType>>& received, rgmc::OverwriteVector<double>& sums) const
   {
     const std::vector<vtkIdType>& gid = this->Numbering.Gid;
     std::vector<std::size_t> cursor(this->AllRanks.Size, 0);
@@ -286,7 +286,8 @@ private:
     }
   }
 
-  rgmc::LargeVector<double> TriangleCross; // per triangle, while the normals are summed
+  // Per triangle, while the normals are summed (written whole by ComputeTriangleCrosses).
+  rgmc::OverwriteVector<double> TriangleCross;
 };
 
 } // namespace seam

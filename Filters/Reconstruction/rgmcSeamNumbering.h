@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -148,25 +149,44 @@ LocalVertices DistinctVertices(const rgmc::LargeVector<IdentifiedPoint<Words>>& 
   std::vector<Identity<Words>>& ids)
 {
   LocalVertices local;
-  bool duplicates = false;
-  for (std::size_t i = 1; i < all.size() && !duplicates; ++i)
+  // Copies of a vertex (sorted: side by side), looked for on threads, as are the vertices copied
+  // when there are none (the common case: the points were merged before).
+  const vtkIdType size = static_cast<vtkIdType>(all.size());
+  std::atomic<bool> duplicates{ false };
+  rgmc::ForEachChunk(size, rgmc::ElementChunk,
+    [&](vtkIdType, vtkIdType first, vtkIdType last)
+    {
+      bool found = false;
+      for (vtkIdType i = std::max<vtkIdType>(first, 1); i < last && !found; ++i)
+      {
+        found = all[i].first == all[i - 1].first;
+      }
+      if (found)
+      {
+        duplicates = true;
+      }
+    });
+  if (!duplicates)
   {
-    duplicates = all[i].first == all[i - 1].first;
+    ids.resize(all.size());
+    local.Sorted.resize(all.size());
+    rgmc::ForEachChunk(size, rgmc::ElementChunk,
+      [&](vtkIdType, vtkIdType first, vtkIdType last)
+      {
+        for (vtkIdType i = first; i < last; ++i)
+        {
+          ids[i] = all[i].first;
+          local.Sorted[i] = all[i].second;
+        }
+      });
+    local.Count = size;
+    return local;
   }
   ids.reserve(all.size());
   local.Sorted.reserve(all.size());
-  if (duplicates)
-  {
-    local.VertexOfPoint.resize(static_cast<std::size_t>(n));
-  }
+  local.VertexOfPoint.resize(static_cast<std::size_t>(n));
   for (std::size_t i = 0; i < all.size(); ++i)
   {
-    if (!duplicates)
-    {
-      ids.push_back(all[i].first);
-      local.Sorted.push_back(all[i].second);
-      continue;
-    }
     if (i == 0 || all[i].first != all[i - 1].first)
     {
       local.Sorted.push_back(static_cast<vtkIdType>(ids.size()));
@@ -245,10 +265,14 @@ public:
         {
           numbering.Total = this->Vertices.Count;
           numbering.Gid.resize(static_cast<std::size_t>(this->Vertices.Count));
-          for (vtkIdType i = 0; i < this->Vertices.Count; ++i)
-          {
-            numbering.Gid[this->Vertices.Sorted[i]] = i;
-          }
+          rgmc::ForEachChunk(this->Vertices.Count, rgmc::ElementChunk,
+            [&](vtkIdType, vtkIdType first, vtkIdType last)
+            {
+              for (vtkIdType i = first; i < last; ++i)
+              {
+                numbering.Gid[this->Vertices.Sorted[i]] = i;
+              }
+            });
           numbering.Holding.assign(
             static_cast<std::size_t>(this->Vertices.Count), GlobalNumbering::Alone);
           std::vector<Identity<Words>>().swap(this->Ids);

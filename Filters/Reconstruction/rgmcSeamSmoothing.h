@@ -51,8 +51,8 @@ public:
       return false;
     }
     // The stencils are done with: the normals need the memory.
-    rgmc::LargeVector<I>().swap(this->Stencil.Neighbours);
-    std::vector<std::int64_t>().swap(this->Stencil.Offsets);
+    rgmc::OverwriteVector<I>().swap(this->Stencil.Neighbours);
+    rgmc::OverwriteVector<std::int64_t>().swap(this->Stencil.Offsets);
     std::vector<I>().swap(this->Owned);
     if (!this->AllRanks.Agree(true, problem) || aborted)
     {
@@ -70,15 +70,23 @@ private:
     const std::function<bool(double)>& progress, bool& aborted, std::string& problem)
   {
     const std::size_t size = 3 * (this->NumVertices + this->RemoteGids.size());
-    rgmc::LargeVector<double> current, next;
+    rgmc::OverwriteVector<double> current, next; // both filled whole below, on threads
     if (!this->AllRanks.Step("smooth the surface", problem,
           [&]()
           {
             current.resize(size);
             next.resize(size);
-            std::copy(this->Positions, this->Positions + 3 * this->NumVertices, current.begin());
-            std::copy(this->RemoteInitial.begin(), this->RemoteInitial.end(),
-              current.begin() + 3 * this->NumVertices);
+            const std::size_t own = 3 * static_cast<std::size_t>(this->NumVertices);
+            rgmc::ForEachChunk(static_cast<vtkIdType>(size), rgmc::ElementChunk,
+              [&](vtkIdType, vtkIdType first, vtkIdType last)
+              {
+                for (vtkIdType i = first; i < last; ++i)
+                {
+                  current[i] = next[i] = static_cast<std::size_t>(i) < own
+                    ? static_cast<double>(this->Positions[i])
+                    : this->RemoteInitial[static_cast<std::size_t>(i) - own];
+                }
+              });
           }))
     {
       return false;
@@ -100,9 +108,20 @@ private:
       this->Update(next.data());
       std::swap(current, next);
     }
-    rgmc::LargeVector<double>().swap(next);
+    rgmc::OverwriteVector<double>().swap(next);
     return this->AllRanks.Step("smooth the surface", problem,
-      [&]() { this->Smoothed.assign(current.begin(), current.begin() + 3 * this->NumVertices); });
+      [&]()
+      {
+        this->Smoothed.resize(3 * static_cast<std::size_t>(this->NumVertices));
+        rgmc::ForEachChunk(3 * this->NumVertices, rgmc::ElementChunk,
+          [&](vtkIdType, vtkIdType first, vtkIdType last)
+          {
+            for (vtkIdType i = first; i < last; ++i)
+            {
+              this->Smoothed[i] = static_cast<T>(current[i]);
+            }
+          });
+      });
   }
 
   /// Windowed sinc, in the points' type, as VTK's filter: x0, x1, x2 the last three states,

@@ -404,8 +404,10 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
       const std::vector<T>& moved = run.Smooth ? repair.Smoothed : copied;
       vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
       xyz->SetNumberOfComponents(3);
-      std::copy(moved.begin(), moved.begin() + 3 * run.Vertices.Count,
-        rgmc::Allocate(xyz.Get(), 3 * run.Vertices.Count));
+      T* to = rgmc::Allocate(xyz.Get(), 3 * run.Vertices.Count);
+      rgmc::ForEachChunk(3 * run.Vertices.Count, rgmc::ElementChunk,
+        [&](vtkIdType, vtkIdType first, vtkIdType last)
+        { std::copy(moved.begin() + first, moved.begin() + last, to + first); });
       run.Points->SetData(xyz);
     });
 }
@@ -471,14 +473,19 @@ void vtkRGSeamRepair::BuildOutput(Run& run, vtkPolyData* output)
   gids->SetName("GlobalPointIds");
   vtkNew<vtkUnsignedCharArray> ghosts;
   ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-  std::copy(run.Numbering.Gid.begin(), run.Numbering.Gid.end(), rgmc::Allocate(gids.Get(), n));
+  vtkIdType* gid = rgmc::Allocate(gids.Get(), n);
   unsigned char* ghost = rgmc::Allocate(ghosts.Get(), n);
-  for (vtkIdType v = 0; v < n; ++v)
-  {
-    ghost[v] = (run.Numbering.Holding[v] & GlobalNumbering::Foreign)
-      ? vtkDataSetAttributes::DUPLICATEPOINT
-      : 0;
-  }
+  rgmc::ForEachChunk(n, rgmc::ElementChunk,
+    [&](vtkIdType, vtkIdType first, vtkIdType last)
+    {
+      for (vtkIdType v = first; v < last; ++v)
+      {
+        gid[v] = run.Numbering.Gid[v];
+        ghost[v] = (run.Numbering.Holding[v] & GlobalNumbering::Foreign)
+          ? vtkDataSetAttributes::DUPLICATEPOINT
+          : 0;
+      }
+    });
   pd->SetGlobalIds(gids);
   pd->AddArray(ghosts);
   if (run.Smooth)

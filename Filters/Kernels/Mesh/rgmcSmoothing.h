@@ -127,11 +127,13 @@ std::vector<double> SincCoefficients(int iterations, double passBand, SincWindow
 /// Smoothing stencils of many vertices, in compressed rows: the neighbours of vertex row r are
 /// Neighbours[Offsets[r] .. Offsets[r + 1]), indices into the point arrays, of type Index (32
 /// bits where the points' count allows: the smoothing steps read every row each iteration).
+/// Rows are appended, or room made for them and then filled (on threads: nothing is zeroed
+/// first).
 template <typename Index = std::int64_t>
 struct Stencils
 {
-  std::vector<std::int64_t> Offsets{ 0 };
-  LargeVector<Index> Neighbours;
+  OverwriteVector<std::int64_t> Offsets{ 0 };
+  OverwriteVector<Index> Neighbours;
 };
 
 // Each step below updates the rows [first, last) (all by default); rows are independent, so
