@@ -42,7 +42,7 @@ inline void AssembleMesh(Block& block, const VertexTable& seen, bool areaWeighte
     std::copy(record.Point, record.Point + 3, mesh.Points.begin() + 3 * v);
     if (seen.HasQuadrics)
     {
-      mesh.Quadrics[v] = seen.Quadrics[at];
+      mesh.Quadrics[v].Terms = seen.Quadrics[at];
     }
   }
   auto local = [&mesh](vtkIdType id)
@@ -211,7 +211,7 @@ private:
         Vertex& out = this->Vertices.Vertices[record];
         out.Id = mesh.Ids[v];
         std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, out.Point);
-        this->Vertices.Quadrics[record++] = mesh.Quadrics[v];
+        this->Vertices.Quadrics[record++] = mesh.Quadrics[v].Terms;
       }
     }
   }

@@ -61,7 +61,9 @@ class VertexTable
 {
 public:
   rgmc::OverwriteVector<Vertex> Vertices; // by increasing id once sorted
-  std::vector<rgmc::Quadric> Quadrics;
+  // A quadric's terms, as plain arrays: grown by Grow, or gathered, without being zeroed first
+  // on one thread (a million vertices' quadrics are 80 MB).
+  rgmc::OverwriteVector<std::array<double, 10>> Quadrics;
   bool HasQuadrics = false;
 
   std::size_t Words() const { return this->HasQuadrics ? 14 : 4; }
@@ -78,7 +80,7 @@ public:
     }
     for (std::size_t k = 0; this->HasQuadrics && k < 10; ++k)
     {
-      *out++ = rgmc::WordOf(this->Quadrics[i].Terms[k]);
+      *out++ = rgmc::WordOf(this->Quadrics[i][k]);
     }
   }
 
@@ -100,7 +102,7 @@ public:
     }
     for (std::size_t k = 0; this->HasQuadrics && k < 10; ++k)
     {
-      this->Quadrics[i].Terms[k] = rgmc::RealOf(words[4 + k]);
+      this->Quadrics[i][k] = rgmc::RealOf(words[4 + k]);
     }
   }
 
@@ -115,7 +117,7 @@ public:
     this->Vertices.push_back(v);
     if (this->HasQuadrics)
     {
-      this->Quadrics.push_back(*q);
+      this->Quadrics.push_back(q->Terms);
     }
   }
 
@@ -149,7 +151,8 @@ public:
         continue;
       }
       const Vertex vertex = this->Vertices[i];
-      const rgmc::Quadric quadric = this->HasQuadrics ? this->Quadrics[i] : rgmc::Quadric();
+      const std::array<double, 10> quadric =
+        this->HasQuadrics ? this->Quadrics[i] : std::array<double, 10>{};
       std::size_t at = i;
       while (order[at].second != i)
       {
@@ -206,8 +209,8 @@ public:
     { return i == 0 || this->Vertices[from[i]].Id != this->Vertices[from[i - 1]].Id; };
     const std::vector<std::size_t> before =
       rgmc::CountBefore(static_cast<vtkIdType>(n), rgmc::ElementChunk, isFirst);
-    decltype(this->Vertices) vertices(before.back()); // written whole below
-    std::vector<rgmc::Quadric> quadrics(this->HasQuadrics ? before.back() : 0);
+    decltype(this->Vertices) vertices(before.back());                         // written whole below
+    decltype(this->Quadrics) quadrics(this->HasQuadrics ? before.back() : 0); // written whole
     rgmc::ForEachChunk(static_cast<vtkIdType>(n), rgmc::ElementChunk,
       [&](vtkIdType c, vtkIdType begin, vtkIdType end)
       {
@@ -232,7 +235,7 @@ public:
   void Clear()
   {
     decltype(this->Vertices)().swap(this->Vertices);
-    std::vector<rgmc::Quadric>().swap(this->Quadrics);
+    decltype(this->Quadrics)().swap(this->Quadrics);
   }
 };
 

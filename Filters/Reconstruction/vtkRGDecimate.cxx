@@ -522,7 +522,7 @@ void vtkRGDecimate::RecordSharedVertices(Run& run, const Messages& told)
       shared.emplace_back(words[at], words[at + 1]);
     }
   }
-  std::sort(shared.begin(), shared.end());
+  rgmc::ParallelSort(shared); // equal pairs are the same pair: any order of them will do
   shared.erase(std::unique(shared.begin(), shared.end()), shared.end());
   run.SharedFirst.assign(run.Part.NumberOfVertices() + 1, 0);
   run.SharedBlocks.resize(shared.size());

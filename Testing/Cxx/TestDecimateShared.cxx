@@ -483,7 +483,7 @@ void TestKeepTriangles()
       part.Vertices.Quadrics.resize(part.Vertices.Vertices.size());
       for (auto& q : part.Vertices.Quadrics)
       {
-        for (double& term : q.Terms)
+        for (double& term : q)
         {
           term = static_cast<double>(random() % 100000) / 7.0;
         }

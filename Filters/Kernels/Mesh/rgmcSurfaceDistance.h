@@ -675,10 +675,10 @@ private:
   double Inverse = 1; // 1 / Size
   double Slack = 0;   // a distance far above the rounding of any coordinate (Cutoff)
   int Dims[3] = { 1, 1, 1 };
-  std::vector<std::int64_t> Keys;   // bucket b's key (Key), increasing
-  KeyIndex Index;                   // a bucket's key to its number b
-  std::vector<std::uint64_t> Start; // bucket b's items: [Start[b], Start[b + 1])
-  std::vector<std::uint32_t> Items;
+  std::vector<std::int64_t> Keys;       // bucket b's key (Key), increasing
+  KeyIndex Index;                       // a bucket's key to its number b
+  std::vector<std::uint64_t> Start;     // bucket b's items: [Start[b], Start[b + 1])
+  OverwriteVector<std::uint32_t> Items; // written whole by Group
 };
 
 /// Buckets of the corners' type: TriangleBuckets buckets(corners, size, parallel).
