@@ -2,7 +2,8 @@
 // size, sorted by slab in groups of blocks on tasks run in any order, against std::stable_sort
 // on k of the whole list (growth's order kept within a slab): the same nodes in the same order,
 // the box, each slab's first node and its triangles; for groups of one block, of a few nodes,
-// and one group of everything; tasks in order, in reverse, and on threads.
+// and one group of everything; tasks in order, in reverse, and on threads. Then extraction's
+// chunks of slabs (ChunkStarts) and the slices of triangles they fill (Buffer::Borrow).
 #include "rgmcCheck.h"
 #include "rgmcNodesBySlab.h"
 #include "rgmcTaskOrders.h"
@@ -10,6 +11,7 @@
 #include "vtkMarchingCubesTriangleCases.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -99,10 +101,109 @@ void Check(unsigned seed, int numBlocks, std::size_t nodesPerGroup,
   }
 }
 
+/// ChunkStarts on `slabs`, asked for `wanted` chunks: they cover the slabs in order, none
+/// empty, at most `wanted`, each within a share of the triangles plus the largest slab (fewer
+/// chunks where a slab holds several shares).
+void CheckChunks(const std::vector<std::int64_t>& slabs, int wanted, const char* how)
+{
+  const std::vector<int> starts = rgmc::ChunkStarts(slabs, wanted);
+  const int numSlabs = static_cast<int>(slabs.size());
+  const int chunks = static_cast<int>(starts.size()) - 1;
+  RGMC_CHECK(starts.front() == 0 && starts.back() == numSlabs, how << ": chunks cover the slabs");
+  RGMC_CHECK(chunks >= 1 && chunks <= std::max(1, wanted), how << ": " << chunks << " chunks");
+  std::int64_t total = 0, largest = 0;
+  for (const std::int64_t t : slabs)
+  {
+    total += t;
+    largest = std::max(largest, t);
+  }
+  for (int c = 0; c < chunks; ++c)
+  {
+    RGMC_CHECK(starts[c + 1] > starts[c], how << ": chunk " << c << " is empty");
+    std::int64_t held = 0;
+    for (int s = starts[c]; s < starts[c + 1]; ++s)
+    {
+      held += slabs[s];
+    }
+    RGMC_CHECK(held * wanted <= total + largest * wanted,
+      how << ": chunk " << c << " holds " << held << " of " << total << " triangles");
+  }
+}
+
+void CheckChunkStarts()
+{
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    std::vector<std::int64_t> slabs(1 + random() % 300);
+    for (std::int64_t& t : slabs)
+    {
+      // Sparse, uniform, and a few slabs much larger than the rest.
+      const unsigned kind = random() % 10;
+      t = kind < 2 ? 0 : kind < 9 ? random() % 1000 : 20000 + random() % 50000;
+    }
+    for (int wanted : { 1, 2, 7, 32, 64, 1000 })
+    {
+      CheckChunks(slabs, wanted, "random slabs");
+    }
+  }
+  // Equal slabs cut into equal chunks; one heavy slab gets a chunk of its own.
+  const std::vector<int> even = rgmc::ChunkStarts(std::vector<std::int64_t>(64, 10), 16);
+  RGMC_CHECK(even.size() == 17, "16 chunks of 64 equal slabs, not " << even.size() - 1);
+  for (std::size_t c = 0; c + 1 < even.size(); ++c)
+  {
+    RGMC_CHECK(even[c + 1] - even[c] == 4, "equal slabs: chunk " << c << " of 4 slabs");
+  }
+  std::vector<std::int64_t> heavy(40, 1);
+  heavy[20] = 1000;
+  const std::vector<int> cut = rgmc::ChunkStarts(heavy, 4);
+  RGMC_CHECK(std::find(cut.begin(), cut.end(), 20) != cut.end() &&
+      std::find(cut.begin(), cut.end(), 21) != cut.end(),
+    "the heavy slab alone in its chunk");
+  CheckChunks(std::vector<std::int64_t>(5, 0), 3, "no triangles");
+}
+
+/// Buffer::Borrow, as extraction's chunks use it: a buffer fills its slice of a shared array in
+/// place, never writes beyond it, and moves to storage of its own when it outgrows it; freeing
+/// or handing it over never frees the shared array (AddressSanitizer's build would say).
+void CheckBorrowedBuffer()
+{
+  std::vector<std::int32_t> shared(100, -7);
+  {
+    rgmc::Buffer<std::int32_t> slice;
+    slice.push_back(99); // storage of its own first, freed by Borrow
+    slice.Borrow(shared.data() + 10, 20);
+    RGMC_CHECK(slice.empty(), "a borrowed buffer starts empty");
+    for (int v = 0; v < 20; ++v)
+    {
+      slice.push_back(v);
+    }
+    RGMC_CHECK(slice.data() == shared.data() + 10 && shared[10] == 0 && shared[29] == 19,
+      "values written in the slice");
+    slice.push_back(20);
+    RGMC_CHECK(slice.data() != shared.data() + 10 && slice.size() == 21 && slice[0] == 0 &&
+        slice[19] == 19 && slice[20] == 20 && shared[30] == -7,
+      "beyond its slice, the buffer moves its values to storage of its own");
+  }
+  rgmc::Buffer<std::int32_t> handed;
+  handed.Borrow(shared.data() + 40, 10);
+  handed.append(shared.data(), 3);
+  std::int32_t* own = handed.Release();
+  RGMC_CHECK(own != shared.data() + 40 && own[2] == -7, "a borrowed buffer hands over a copy");
+  std::free(own);
+  rgmc::Buffer<std::int32_t> freed;
+  freed.Borrow(shared.data() + 60, 10);
+  freed.push_back(1);
+  freed.FreeNow();
+  RGMC_CHECK(freed.empty() && shared[9] == -7 && shared[70] == -7, "FreeNow on a borrowed slice");
+}
+
 } // namespace
 
 int main()
 {
+  CheckChunkStarts();
+  CheckBorrowedBuffer();
   // Groups: one block each (nodesPerGroup 1), a few blocks, one group of all blocks.
   for (unsigned seed = 1; seed <= 12; ++seed)
   {

@@ -207,24 +207,41 @@ public:
     : Data(other.Data)
     , Size(other.Size)
     , Capacity(other.Capacity)
+    , Borrowed(other.Borrowed)
   {
     other.Data = nullptr;
     other.Size = other.Capacity = 0;
+    other.Borrowed = false;
   }
   Buffer& operator=(Buffer&& other) noexcept
   {
     if (this != &other)
     {
-      std::free(this->Data);
+      this->FreeOwn();
       this->Data = other.Data;
       this->Size = other.Size;
       this->Capacity = other.Capacity;
+      this->Borrowed = other.Borrowed;
       other.Data = nullptr;
       other.Size = other.Capacity = 0;
+      other.Borrowed = false;
     }
     return *this;
   }
-  ~Buffer() { std::free(this->Data); }
+  ~Buffer() { this->FreeOwn(); }
+
+  /// Empties the buffer and gives it `capacity` values at `data` as its storage, owned by the
+  /// caller (a slice of a larger array), which must outlive its use here: many buffers filled
+  /// at once then share one array's huge pages instead of each paging in its own 4 KiB pages.
+  /// Growth beyond `capacity` moves the values to storage of the buffer's own.
+  void Borrow(T* data, std::size_t capacity)
+  {
+    this->FreeOwn();
+    this->Data = data;
+    this->Size = 0;
+    this->Capacity = capacity;
+    this->Borrowed = true;
+  }
 
   std::size_t size() const { return this->Size; }
   bool empty() const { return this->Size == 0; }
@@ -242,13 +259,19 @@ public:
   {
     if (capacity > this->Capacity)
     {
-      T* grown = static_cast<T*>(std::realloc(this->Data, capacity * sizeof(T)));
+      T* grown =
+        static_cast<T*>(std::realloc(this->Borrowed ? nullptr : this->Data, capacity * sizeof(T)));
       if (!grown)
       {
         throw std::bad_alloc();
       }
+      if (this->Borrowed && this->Size > 0)
+      {
+        std::memcpy(grown, this->Data, this->Size * sizeof(T));
+      }
       this->Data = grown;
       this->Capacity = capacity;
+      this->Borrowed = false;
     }
   }
 
@@ -292,27 +315,34 @@ public:
     {
       std::memcpy(grown, this->Data, this->Size * sizeof(T));
     }
-    std::free(this->Data);
+    this->FreeOwn();
     this->Data = grown;
     this->Capacity = rounded / sizeof(T);
     this->Size = n;
+    this->Borrowed = false;
   }
 
   /// Shrinks to the first n values (n <= size()).
   void resize_down(std::size_t n) { this->Size = n < this->Size ? n : this->Size; }
 
-  /// Frees the storage now, its pages given back first (DiscardPages), and empties the buffer.
+  /// Frees the storage now, its pages given back first (DiscardPages: borrowed storage too, the
+  /// whole pages inside it), and empties the buffer.
   void FreeNow()
   {
     DiscardPages(this->Data, this->Capacity * sizeof(T));
-    std::free(this->Data);
+    this->FreeOwn();
     this->Data = nullptr;
     this->Size = this->Capacity = 0;
   }
 
-  /// Hands over the storage (to be released with std::free) and empties the buffer.
+  /// Hands over the storage (to be released with std::free; borrowed values are copied to
+  /// storage of the buffer's own first) and empties the buffer.
   T* Release()
   {
+    if (this->Borrowed)
+    {
+      this->reserve(this->Capacity + 1);
+    }
     T* data = this->Data;
     this->Data = nullptr;
     this->Size = this->Capacity = 0;
@@ -322,9 +352,19 @@ public:
 private:
   RGMC_NOINLINE void Grow(std::size_t capacity) { this->reserve(capacity); }
 
+  void FreeOwn()
+  {
+    if (!this->Borrowed)
+    {
+      std::free(this->Data);
+    }
+    this->Borrowed = false;
+  }
+
   T* Data = nullptr;
   std::size_t Size = 0;
   std::size_t Capacity = 0;
+  bool Borrowed = false; // Data is the caller's (Borrow)
 };
 
 /// A fixed-size array of zeros whose pages come from the operating system as they are first

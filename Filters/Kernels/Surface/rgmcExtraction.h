@@ -181,38 +181,54 @@ public:
     this->PlaneSize = static_cast<std::size_t>(this->LayerNx) * (box.Hi[1] - box.Lo[1] + 2);
 
     this->Volume.Mark("extraction: chunks");
-    // Chunks of a few slabs, all extracted in one parallel step: enough of them for many
-    // threads, few enough that the vertices made twice (on the planes between chunks) cost
-    // little. The chunks depend on the slabs only, never on the threads.
+    // Chunks of slabs, all extracted in one parallel step: enough of them for many threads,
+    // few enough that the vertices made twice (on the planes between chunks) cost little; cut
+    // where they hold equal shares of the triangles, so that the longest is short. The chunks
+    // depend on the slabs only, never on the threads, and the joined mesh on neither.
     const int chunkSlabs = std::max(MinChunkSlabs, std::min(MaxChunkSlabs, numSlabs / 32));
-    const int numChunks = (numSlabs + chunkSlabs - 1) / chunkSlabs;
+    const std::vector<int> chunkStart =
+      ChunkStarts(slabTriangles, (numSlabs + chunkSlabs - 1) / chunkSlabs);
+    const int numChunks = static_cast<int>(chunkStart.size()) - 1;
     std::vector<Chunk> chunks(static_cast<std::size_t>(numChunks));
-    this->Volume.Parallel(numChunks,
-      [&](std::int64_t chunk)
+    // Each chunk's triangles (at most its slabs' count) and their components go in its slices
+    // of one array shared by all chunks, in huge pages: 16 bytes a triangle that would
+    // otherwise fault in 4 KiB at a time (a fault costs microseconds under a hypervisor).
+    std::vector<std::int64_t> firstTriangle(static_cast<std::size_t>(numChunks) + 1, 0);
+    for (int c = 0; c < numChunks; ++c)
+    {
+      firstTriangle[c + 1] = firstTriangle[c];
+      for (int s = chunkStart[c]; s < chunkStart[c + 1]; ++s)
       {
-        const int first = static_cast<int>(chunk) * chunkSlabs;
-        const int last = std::min(numSlabs, first + chunkSlabs);
-        std::int64_t triangles = 0;
-        for (int s = first; s < last; ++s)
-        {
-          triangles += slabTriangles[s];
-        }
-        this->ExtractChunk(nodes, start, first, last, triangles, chunks[chunk]);
+        firstTriangle[c + 1] += slabTriangles[s];
+      }
+    }
+    const std::size_t bound = static_cast<std::size_t>(firstTriangle.back());
+    this->ChunkTriangles.resize_for_overwrite(4 * bound); // 3 ids a triangle, then components
+    this->Volume.Parallel(numChunks,
+      [&](std::int64_t c)
+      {
+        const std::int64_t t0 = firstTriangle[c], triangles = firstTriangle[c + 1] - t0;
+        LocalMesh& m = chunks[c].Mesh;
+        std::int32_t* store = this->ChunkTriangles.data();
+        m.Triangles.Borrow(store + 3 * t0, 3 * static_cast<std::size_t>(triangles));
+        m.TriangleComponent.Borrow(store + 3 * bound + t0, static_cast<std::size_t>(triangles));
+        this->ExtractChunk(nodes, start, chunkStart[c], chunkStart[c + 1], triangles, chunks[c]);
       });
     this->Volume.Report(0.95);
     this->Pool.clear();
-    if (this->Volume.Stopped())
+    if (!this->Volume.Stopped())
     {
-      return;
+      this->JoinChunks(chunks);
+      this->Volume.Report(1.0);
     }
-    this->JoinChunks(chunks);
-    this->Volume.Report(1.0);
+    chunks.clear(); // before the arrays they borrowed from
+    this->ChunkTriangles.FreeNow();
   }
 
 private:
   static constexpr std::size_t NodesPerGroup = 8192; // nodes by slab: nodes per task
   static constexpr std::int64_t TotalsRange = 65536; // component totals: triangles per task
-  static constexpr int MinChunkSlabs = 4;            // slabs of cubes per chunk (not per thread)
+  static constexpr int MinChunkSlabs = 4; // slabs of cubes per chunk, on average (not per thread)
   static constexpr int MaxChunkSlabs = 16;
   static constexpr int PrefetchAhead = 16; // nodes between a prefetch and the node's use
 
@@ -265,6 +281,9 @@ private:
     std::unique_ptr<KeyMap> PointVertices;
   };
 
+  // The chunks' triangles, then their components, each chunk's in slices (Extract).
+  Buffer<std::int32_t> ChunkTriangles;
+
   std::unique_ptr<ChunkWork> TakeWork()
   {
     {
@@ -305,13 +324,12 @@ private:
     work.PointVertices.reset(new KeyMap(64));
     chunk.LowK = box.Lo[2] + first;
     chunk.TopK = box.Lo[2] + last; // the plane above the last slab
-    // A node emits at most its case's triangles; a closed surface has about half as many
-    // vertices as triangles. A chunk's vertices are keys and components only: their positions
-    // and normals are computed from the keys into the joined mesh (CopyChunks).
+    // A node emits at most its case's triangles (the room of the chunk's slices, Extract); a
+    // closed surface has about half as many vertices as triangles. A chunk's vertices are keys
+    // and components only: their positions and normals are computed from the keys into the
+    // joined mesh (CopyChunks).
     LocalMesh& m = chunk.Mesh;
     const std::size_t vertices = static_cast<std::size_t>(triangles / 2 + 64);
-    m.Triangles.reserve(static_cast<std::size_t>(3 * triangles));
-    m.TriangleComponent.reserve(static_cast<std::size_t>(triangles));
     m.Keys.reserve(vertices);
     m.VertexComponent.reserve(vertices);
     // Vertex ids of the edges in the current slab: x and y edges on its bottom and top planes,

@@ -52,6 +52,39 @@ inline std::vector<std::size_t> NodeGroups(const NodeList& found, std::size_t no
   return first;
 }
 
+/// Cuts slabs with `slabTriangles` triangles each into at most `wanted` chunks of consecutive
+/// slabs (extraction's tasks), each holding about an equal share of the triangles: a chunk
+/// ends before the slab that its share's end falls in, or after it, whichever is nearer. No
+/// chunk is empty; each holds at most its share plus the largest slab's triangles. They depend
+/// on the slabs only, never on the threads. Returns each chunk's first slab and, last, the
+/// number of slabs.
+inline std::vector<int> ChunkStarts(const std::vector<std::int64_t>& slabTriangles, int wanted)
+{
+  const int numSlabs = static_cast<int>(slabTriangles.size());
+  std::int64_t total = 0;
+  for (const std::int64_t t : slabTriangles)
+  {
+    total += t;
+  }
+  const std::int64_t chunks = std::max(1, std::min(wanted, numSlabs));
+  std::vector<int> starts{ 0 };
+  std::int64_t sofar = 0;
+  for (int s = 0; s < numSlabs; ++s)
+  {
+    // Chunk n (from 0) closes before slab s once the slabs before s and half of s hold n + 1
+    // shares of the triangles.
+    const std::int64_t n = static_cast<std::int64_t>(starts.size()) - 1;
+    if (s > starts.back() && n + 1 < chunks &&
+      (2 * sofar + slabTriangles[s]) * chunks >= 2 * (n + 1) * total)
+    {
+      starts.push_back(s);
+    }
+    sofar += slabTriangles[s];
+  }
+  starts.push_back(numSlabs);
+  return starts;
+}
+
 /// Sorts `found` (not empty) by slab into `out`: each group of blocks (NodeGroups) finds its box
 /// and counts its nodes and triangles per slab, then each group's first place in each slab is
 /// known and the groups scatter their nodes. parallel(count, task) runs task(i) for every i in
