@@ -319,7 +319,6 @@ public:
     this->Data = grown;
     this->Capacity = rounded / sizeof(T);
     this->Size = n;
-    this->Borrowed = false;
   }
 
   /// Shrinks to the first n values (n <= size()).
