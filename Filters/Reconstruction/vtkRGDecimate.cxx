@@ -814,11 +814,15 @@ bool vtkRGDecimate::NumberSurface(Run& run, vtkPolyData* output)
     return false;
   }
   vtkNew<vtkRGSeamRepair> numbering;
-  rgmc::SpanPrefix phases("numbering: ", "after numbering");
-  numbering->SetController(run.Ranks.Controller());
-  numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
-  numbering->SetInputData(piece);
-  const int ok = numbering->GetExecutive()->Update();
+  int ok = 0;
+  {
+    // The numbering's phases in a work/span profile, until its run ends (not the report's).
+    rgmc::SpanPrefix phases("numbering: ", "after numbering");
+    numbering->SetController(run.Ranks.Controller());
+    numbering->SetSmoothingMethod(vtkRGSeamRepair::NO_SMOOTHING);
+    numbering->SetInputData(piece);
+    ok = numbering->GetExecutive()->Update();
+  }
   this->NumberOfCollectives += numbering->GetNumberOfCollectives();
   if (!ok)
   {
