@@ -557,10 +557,17 @@ private:
         box2[i] = BoxDistance2(p, this->Corners + 9 * std::size_t(this->Items[first + i]));
       }
     }
+    // The first of the nearest boxes, its distance kept in a register: a comparison a triangle,
+    // not a load that waits on the one before.
     std::uint64_t nearest = 0;
+    double nearestBox2 = count > 0 ? box2[0] : 0.0;
     for (std::uint64_t i = 1; i < count; ++i)
     {
-      nearest = box2[i] < box2[nearest] ? i : nearest;
+      if (box2[i] < nearestBox2)
+      {
+        nearestBox2 = box2[i];
+        nearest = i;
+      }
     }
     auto measure = [&](std::uint64_t i)
     {
@@ -602,6 +609,14 @@ private:
     {
       memo.Low[a].resize(count);
       memo.High[a].resize(count);
+    }
+    // The triangles' corners are scattered over the surface: their loads asked for all at once,
+    // before the copy's loop, whose work per triangle would otherwise leave few of them in flight.
+    for (std::uint64_t i = 0; i < count; ++i)
+    {
+      const T* t = this->Corners + 9 * std::size_t(this->Items[first + i]);
+      __builtin_prefetch(t);
+      __builtin_prefetch(t + 8); // a triangle may straddle two cache lines
     }
     for (std::uint64_t i = 0; i < count; ++i)
     {
