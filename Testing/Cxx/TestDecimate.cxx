@@ -29,6 +29,7 @@
 #include "vtkRGDecimate.h"
 #include "vtkRGPhantomSource.h"
 #include "vtkRGSeamRepair.h"
+#include "vtkRGSpan.h"
 
 #include <algorithm>
 #include <array>
@@ -377,6 +378,27 @@ void CheckSurface(const Merged& input, const Merged& output, vtkPolyData* piece,
     what << ": global ids are not 0..N-1");
 }
 
+/// The phases of a work/span profile of a decimation with its distance report: the numbering's
+/// own phases under "numbering: ", the report's under their own names (not the numbering's).
+void SpanPhases(vtkMultiProcessController* controller, vtkPolyData* input)
+{
+  rgmc::SpanRecorder recorder;
+  recorder.Start();
+  const Decimated d = Decimate(controller, input, 0.9);
+  recorder.Stop();
+  RGMC_CHECK(d.Errors.empty(), "profiled decimation: " << d.Errors);
+  bool sort = false, collect = false, nested = false;
+  for (const rgmc::SpanPhase& phase : recorder.Phases())
+  {
+    sort = sort || phase.Name == "numbering: numbering: sort";
+    collect = collect || phase.Name == "distance: collect";
+    nested = nested || phase.Name.rfind("numbering: distance", 0) == 0;
+  }
+  RGMC_CHECK(sort && collect && !nested,
+    "the profile's phases: the numbering's sort " << sort << ", the report's collect " << collect
+                                                  << ", the report under the numbering " << nested);
+}
+
 void BadInput(vtkMultiProcessController* controller, vtkPolyData* good)
 {
   const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
@@ -608,5 +630,6 @@ int main(int argc, char* argv[])
     }
   }
   BadInput(controller, firstRepaired);
+  SpanPhases(controller, firstRepaired);
   return rgmc_test::Finish(controller, "TestDecimate");
 }
