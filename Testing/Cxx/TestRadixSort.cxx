@@ -2,8 +2,10 @@
 // come out as std::sort on the pairs gives them, for keys that differ in few or many bytes, with
 // many equal keys, and for keys whose top bits are set (unsigned order); the packed sort runs
 // exactly when every key fits above the indices' bits; on tasks (ranges of 65 536 values) run
-// in reverse order and on threads, the same, in a vector that leaves new values unset too. And
-// rgmc::GroupByKey (Seam Repair's corners by vertex on threads) against a counting pass in order.
+// in reverse order and on threads, the same, in a vector that leaves new values unset too; the
+// digits the sorts pass over are those in which keys differ, bytes or wider where that saves a
+// pass. And rgmc::GroupByKey (Seam Repair's corners by vertex on threads) against a counting pass
+// in order.
 #include "rgmcCheck.h"
 #include "rgmcRadixSort.h"
 #include "rgmcTaskOrders.h"
@@ -137,6 +139,17 @@ void CheckGroups(const std::vector<int>& keyOf, std::int64_t keys, const char* w
   }
 }
 
+/// RadixDigits::For(any, every) against the expected digits: their width and lowest bits.
+void CheckDigits(std::uint64_t any, std::uint64_t every, int bits, std::vector<int> shifts)
+{
+  const rgmc::RadixDigits digits = rgmc::RadixDigits::For(any, every);
+  const std::vector<int> got(digits.Shift, digits.Shift + digits.Passes);
+  RGMC_CHECK((shifts.empty() || digits.Bits == bits) && got == shifts,
+    "keys ORed to " << std::hex << any << ", ANDed to " << every << std::dec << ": " << got.size()
+                    << " passes of " << digits.Bits << " bits, expected " << shifts.size() << " of "
+                    << bits);
+}
+
 static_assert(rgmc::LeavesValuesUnset<rgmc::OverwriteVector<Record>>::value &&
     !rgmc::LeavesValuesUnset<rgmc::LargeVector<Record>>::value &&
     !rgmc::LeavesValuesUnset<std::vector<Record>>::value,
@@ -150,6 +163,17 @@ int main()
   Check({}, "empty");
   Check({ 7 }, "one key");
   Check({ 5, 5, 5, 5 }, "all equal");
+  // The digits: only where keys differ; the fewest passes of 8 to 11 bits, the narrowest of them.
+  const std::uint64_t all = ~std::uint64_t(0);
+  CheckDigits(5, 5, 8, {});
+  CheckDigits(0x18, 0, 8, { 3 });                        // bits 3 and 4
+  CheckDigits(0xffff, 0, 8, { 0, 8 });                   // 16 bits: two bytes
+  CheckDigits(0xfffff, 0, 10, { 0, 10 });                // 20 bits: two passes of 10, not three
+  CheckDigits(0xfffff << 7, 0, 10, { 7, 17 });           // the same from bit 7
+  CheckDigits(0xffffffff, 0, 11, { 0, 11, 22 });         // 32 bits: three of 11, not four
+  CheckDigits(all, 0, 11, { 0, 11, 22, 33, 44, 55 });    // 64 bits: six of 11, not eight
+  CheckDigits(0xff000000000000ffULL, 0, 8, { 0, 56 });   // two bytes far apart: wider would take 3
+  CheckDigits(all, 0x00ffffffffffff00ULL, 8, { 0, 56 }); // the same, the bytes between agreeing
   for (std::size_t n : { 2, 3, 255, 256, 257, 10000, 65536, 65537, 300000 })
   {
     std::vector<std::uint64_t> keys(n);
@@ -159,6 +183,12 @@ int main()
       k = random() & ((std::uint64_t(1) << 30) - 1);
     }
     Check(keys, "30-bit keys");
+    // Bucket-key-like: 20 significant bits (two passes of 10 bits).
+    for (auto& k : keys)
+    {
+      k = random() & ((std::uint64_t(1) << 20) - 1);
+    }
+    Check(keys, "20-bit keys");
     // Full 64-bit keys, the top bit set in half of them.
     for (auto& k : keys)
     {

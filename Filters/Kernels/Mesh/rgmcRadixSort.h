@@ -16,10 +16,70 @@
 namespace rgmc
 {
 
+/// The digits a radix sort passes over: only those in which two keys differ (known from the OR
+/// and the AND of all keys), each `Bits` wide from its lowest bit `Shift[p]`. Bytes, or wider
+/// digits (up to 11 bits: 2048 counts a digit) where they take fewer passes: keys of 20 bits are
+/// sorted in two passes of 10 bits, not three of 8.
+struct RadixDigits
+{
+  int Bits = 8;
+  int Passes = 0; // 0: all keys are equal
+  int Shift[8] = {};
+
+  std::size_t Size() const { return std::size_t(1) << this->Bits; }
+  std::size_t Of(std::uint64_t key, int p) const
+  {
+    return static_cast<std::size_t>(key >> this->Shift[p]) & (this->Size() - 1);
+  }
+
+  /// The fewest passes over digits of 8 to 11 bits, the narrowest digits among them, from the
+  /// OR (`any`) and the AND (`every`) of the keys.
+  static RadixDigits For(std::uint64_t any, std::uint64_t every)
+  {
+    const std::uint64_t differ = any & ~every;
+    int low = 0;
+    while (low < 64 && !((differ >> low) & 1))
+    {
+      ++low;
+    }
+    RadixDigits best;
+    for (int bits = 8; bits <= 11; ++bits)
+    {
+      RadixDigits digits;
+      digits.Bits = bits;
+      for (int shift = low; shift < 64; shift += bits)
+      {
+        if ((differ >> shift) & ((std::uint64_t(1) << bits) - 1))
+        {
+          digits.Shift[digits.Passes++] = shift;
+        }
+      }
+      if (bits == 8 || digits.Passes < best.Passes)
+      {
+        best = digits;
+      }
+    }
+    return best;
+  }
+};
+
+/// The OR and the AND of the keys of values[begin, end), folded into any and every.
+template <typename Vector, typename KeyOf>
+void RadixKeyBits(const Vector& values, KeyOf& keyOf, std::size_t begin, std::size_t end,
+  std::uint64_t& any, std::uint64_t& every)
+{
+  for (std::size_t i = begin; i < end; ++i)
+  {
+    const std::uint64_t key = keyOf(values[i]);
+    any |= key;
+    every &= key;
+  }
+}
+
 /// Sorts `values` (a std::vector, with any allocator) by `keyOf(value)` (a std::uint64_t, compared
-/// as unsigned), least significant byte first, skipping the bytes in which all keys agree. Stable:
-/// values with equal keys keep their order. So records (key, index) whose indices increase in the
-/// input come out exactly as std::sort on (key, index) gives them.
+/// as unsigned), least significant digit first, over the digits in which keys differ
+/// (RadixDigits). Stable: values with equal keys keep their order. So records (key, index) whose
+/// indices increase in the input come out exactly as std::sort on (key, index) gives them.
 template <typename Vector, typename KeyOf>
 void RadixSort(Vector& values, KeyOf&& keyOf)
 {
@@ -29,41 +89,40 @@ void RadixSort(Vector& values, KeyOf&& keyOf)
   {
     return;
   }
-  // Every byte's histogram in one pass.
-  std::vector<std::array<std::size_t, 256>> counts(8);
-  for (auto& c : counts)
+  std::uint64_t any = 0, every = ~std::uint64_t(0);
+  RadixKeyBits(values, keyOf, 0, n, any, every);
+  const RadixDigits digits = RadixDigits::For(any, every);
+  if (digits.Passes == 0)
   {
-    c.fill(0);
+    return;
   }
+  // Every digit's histogram in one pass.
+  const std::size_t size = digits.Size();
+  std::vector<std::size_t> counts(digits.Passes * size, 0);
   for (const T& v : values)
   {
     const std::uint64_t key = keyOf(v);
-    for (int b = 0; b < 8; ++b)
+    for (int p = 0; p < digits.Passes; ++p)
     {
-      ++counts[b][(key >> (8 * b)) & 0xff];
+      ++counts[p * size + digits.Of(key, p)];
     }
   }
   Vector buffer(n);
   Vector* from = &values;
   Vector* to = &buffer;
-  for (int b = 0; b < 8; ++b)
+  for (int p = 0; p < digits.Passes; ++p)
   {
-    std::array<std::size_t, 256>& count = counts[b];
-    const std::uint64_t first = (keyOf((*from)[0]) >> (8 * b)) & 0xff;
-    if (count[first] == n)
-    {
-      continue; // every key has this byte
-    }
+    std::size_t* count = counts.data() + p * size;
     std::size_t start = 0;
-    for (std::size_t& c : count)
+    for (std::size_t d = 0; d < size; ++d)
     {
-      const std::size_t here = c;
-      c = start;
+      const std::size_t here = count[d];
+      count[d] = start;
       start += here;
     }
     for (const T& v : *from)
     {
-      (*to)[count[(keyOf(v) >> (8 * b)) & 0xff]++] = v;
+      (*to)[count[digits.Of(keyOf(v), p)]++] = v;
     }
     std::swap(from, to);
   }
@@ -84,68 +143,40 @@ struct RadixRanges
   std::size_t End(std::size_t r) const { return this->N * (r + 1) / this->Count; }
 };
 
-using RadixCounts = std::array<std::size_t, 256>;
-
-/// Every byte's histogram of the keys of each range.
+/// One stable pass on digit p from `from` to `to`: each range counts its digits (`place`, one
+/// count a digit value), then each range's first place for each digit value follows the same
+/// value's places in the ranges before it, then each range scatters.
 template <typename Vector, typename KeyOf, typename Parallel>
-std::vector<std::array<RadixCounts, 8>> RadixHistograms(
-  const Vector& values, KeyOf& keyOf, Parallel& parallel, const RadixRanges& ranges)
+void RadixPass(const Vector& from, Vector& to, const RadixDigits& digits, int p, KeyOf& keyOf,
+  Parallel& parallel, const RadixRanges& ranges, std::vector<std::size_t>& place)
 {
-  std::vector<std::array<RadixCounts, 8>> all(ranges.Count);
+  const std::size_t size = digits.Size();
+  auto digit = [&](const typename Vector::value_type& v) { return digits.Of(keyOf(v), p); };
   parallel(static_cast<std::int64_t>(ranges.Count),
     [&](std::int64_t r)
     {
-      std::array<RadixCounts, 8>& c = all[r];
-      for (RadixCounts& byte : c)
-      {
-        byte.fill(0);
-      }
+      std::size_t* count = place.data() + r * size;
+      std::fill(count, count + size, std::size_t(0));
       for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
       {
-        const std::uint64_t key = keyOf(values[i]);
-        for (int b = 0; b < 8; ++b)
-        {
-          ++c[b][(key >> (8 * b)) & 0xff];
-        }
+        ++count[digit(from[i])];
       }
     });
-  return all;
-}
-
-/// One stable pass on byte b from `from` to `to`: each range's digits (`place`, counted already
-/// when `counted`), then each range's first place for each digit, then the scatter.
-template <typename Vector, typename KeyOf, typename Parallel>
-void RadixPass(const Vector& from, Vector& to, int b, KeyOf& keyOf, Parallel& parallel,
-  const RadixRanges& ranges, std::vector<RadixCounts>& place, bool counted)
-{
-  auto digit = [&keyOf, b](const typename Vector::value_type& v)
-  { return (keyOf(v) >> (8 * b)) & 0xff; };
-  if (!counted)
-  {
-    parallel(static_cast<std::int64_t>(ranges.Count),
-      [&](std::int64_t r)
-      {
-        place[r].fill(0);
-        for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
-        {
-          ++place[r][digit(from[i])];
-        }
-      });
-  }
   std::size_t start = 0;
-  for (int d = 0; d < 256; ++d)
+  for (std::size_t d = 0; d < size; ++d)
   {
-    for (RadixCounts& c : place)
+    for (std::size_t r = 0; r < ranges.Count; ++r)
     {
-      const std::size_t here = c[d];
-      c[d] = start;
+      std::size_t& c = place[r * size + d];
+      const std::size_t here = c;
+      c = start;
       start += here;
     }
   }
   parallel(static_cast<std::int64_t>(ranges.Count),
     [&](std::int64_t r)
     {
-      RadixCounts& next = place[r];
+      std::size_t* next = place.data() + r * size;
       for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
       {
         to[next[digit(from[i])]++] = from[i];
@@ -154,9 +185,9 @@ void RadixPass(const Vector& from, Vector& to, int b, KeyOf& keyOf, Parallel& pa
 }
 
 /// RadixSort on tasks: parallel(count, task) runs task(i) for every i in [0, count), in any
-/// order, possibly at once. Per byte pass, each range of RadixRange values counts its digits
-/// (the histograms' own before the first pass moved anything), then scatters them after the
-/// same digit of the ranges before it: stable, so the result is exactly RadixSort's.
+/// order, possibly at once. The keys' OR and AND range by range, then per digit pass each range
+/// of RadixRange values counts its digits and scatters them after the same digit of the ranges
+/// before it: stable, so the result is exactly RadixSort's.
 template <typename Vector, typename KeyOf, typename Parallel>
 void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
 {
@@ -164,12 +195,24 @@ void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
   const RadixRanges ranges{ n, (n + RadixRange - 1) / RadixRange };
   if (ranges.Count < 2 || std::is_same<typename std::decay<Parallel>::type, SerialTasks>::value)
   {
-    RadixSort(values, keyOf); // one range, or no threads: without the per-pass counts
+    RadixSort(values, keyOf); // one range, or no threads: one histogram pass for every digit
     return;
   }
-  // Which bytes differ among the keys: the histograms, summed.
-  const std::vector<std::array<RadixCounts, 8>> all =
-    RadixHistograms(values, keyOf, parallel, ranges);
+  std::vector<std::array<std::uint64_t, 2>> bits(ranges.Count, { 0, ~std::uint64_t(0) });
+  parallel(static_cast<std::int64_t>(ranges.Count),
+    [&](std::int64_t r)
+    { RadixKeyBits(values, keyOf, ranges.Begin(r), ranges.End(r), bits[r][0], bits[r][1]); });
+  std::uint64_t any = 0, every = ~std::uint64_t(0);
+  for (const auto& b : bits)
+  {
+    any |= b[0];
+    every &= b[1];
+  }
+  const RadixDigits digits = RadixDigits::For(any, every);
+  if (digits.Passes == 0)
+  {
+    return;
+  }
   Vector buffer(n);
   // An unset buffer (OverwriteVector) first touched range by range: a scatter's first range
   // writes into every digit's part of it, and so would fault in all its (huge) pages in one
@@ -185,30 +228,11 @@ void RadixSort(Vector& values, KeyOf&& keyOf, Parallel&& parallel)
   }
   Vector* from = &values;
   Vector* to = &buffer;
-  std::vector<RadixCounts> place(ranges.Count);
-  bool moved = false; // a pass has moved the values
-  for (int b = 0; b < 8; ++b)
+  std::vector<std::size_t> place(ranges.Count * digits.Size());
+  for (int p = 0; p < digits.Passes; ++p)
   {
-    const std::uint64_t first = (keyOf(values[0]) >> (8 * b)) & 0xff;
-    std::size_t same = 0;
-    for (const std::array<RadixCounts, 8>& c : all)
-    {
-      same += c[b][first];
-    }
-    if (same == n)
-    {
-      continue; // every key has this byte
-    }
-    if (!moved)
-    {
-      for (std::size_t r = 0; r < ranges.Count; ++r)
-      {
-        place[r] = all[r][b];
-      }
-    }
-    RadixPass(*from, *to, b, keyOf, parallel, ranges, place, !moved);
+    RadixPass(*from, *to, digits, p, keyOf, parallel, ranges, place);
     std::swap(from, to);
-    moved = true;
   }
   if (from != &values)
   {
