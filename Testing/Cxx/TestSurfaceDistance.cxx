@@ -6,8 +6,9 @@
 // and triangles whose box is beyond the best distance so far; a skip that lost the nearest
 // triangle would show here. Surfaces: random triangles, a fine surface against a coarse copy of
 // itself (a decimation's case: distances far below the triangles' size, many near ties), points
-// on the triangles (distance 0), degenerate and repeated triangles; searches within a limit;
-// the corners kept as doubles and as floats.
+// on the triangles (distance 0), degenerate and repeated triangles, chunks of the build whose
+// triangles have more buckets than its sample made room for; searches within a limit; the
+// corners kept as doubles and as floats.
 #include "rgmcCheck.h"
 #include "rgmcSurfaceDistance.h"
 #include "rgmcTaskOrders.h"
@@ -179,6 +180,31 @@ int main()
       }
     }
     Check<double>(triangles, points, { 0.5, 4, 40 }, "random triangles");
+  }
+  {
+    // Three chunks of the build (16 384 triangles each) whose triangles are far larger than the
+    // ones its sample (every 61st) sees: each chunk's pairs overflow its room in the scratch.
+    std::vector<double> triangles, points;
+    for (int t = 0; t < 40000; ++t)
+    {
+      const double centre[3] = { 60 * unit(random), 60 * unit(random), 60 * unit(random) };
+      const double reach = t % 61 == 0 ? 0.01 : 3;
+      double c[9];
+      for (int k = 0; k < 9; ++k)
+      {
+        c[k] = centre[k % 3] + reach * (unit(random) - 0.5);
+      }
+      rgmc::CanonicalTriangle(c);
+      triangles.insert(triangles.end(), c, c + 9);
+    }
+    for (int q = 0; q < 600; ++q)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        points.push_back(70 * unit(random) - 5);
+      }
+    }
+    Check<double>(triangles, points, { 1, 6 }, "larger triangles than the sample's");
   }
   {
     // A fine surface and a coarse copy of it (a decimation), far from the origin, each
