@@ -151,6 +151,40 @@ void Check(const std::vector<double>& triangles, const std::vector<double>& poin
   }
 }
 
+/// `count` canonical triangles: triangle t's corners within reachOf(t) (a cube's edge) of a
+/// centre drawn in [0, box)^3.
+template <typename ReachOf>
+std::vector<double> RandomTriangles(std::mt19937_64& random, int count, double box, ReachOf reachOf)
+{
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> triangles;
+  for (int t = 0; t < count; ++t)
+  {
+    const double centre[3] = { box * unit(random), box * unit(random), box * unit(random) };
+    const double reach = reachOf(t);
+    double c[9];
+    for (int k = 0; k < 9; ++k)
+    {
+      c[k] = centre[k % 3] + reach * (unit(random) - 0.5);
+    }
+    rgmc::CanonicalTriangle(c);
+    triangles.insert(triangles.end(), c, c + 9);
+  }
+  return triangles;
+}
+
+/// `count` points drawn in [low, low + span)^3.
+std::vector<double> RandomPoints(std::mt19937_64& random, int count, double low, double span)
+{
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> points;
+  for (int k = 0; k < 3 * count; ++k)
+  {
+    points.push_back(span * unit(random) + low);
+  }
+  return points;
+}
+
 } // namespace
 
 int main()
@@ -159,51 +193,17 @@ int main()
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   {
     // Random triangles of many sizes in a box, random points in and around it.
-    std::vector<double> triangles, points;
-    for (int t = 0; t < 3000; ++t)
-    {
-      const double centre[3] = { 100 * unit(random), 100 * unit(random), 100 * unit(random) };
-      const double reach = t % 10 == 0 ? 20 : 2;
-      double c[9];
-      for (int k = 0; k < 9; ++k)
-      {
-        c[k] = centre[k % 3] + reach * (unit(random) - 0.5);
-      }
-      rgmc::CanonicalTriangle(c);
-      triangles.insert(triangles.end(), c, c + 9);
-    }
-    for (int q = 0; q < 3000; ++q)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        points.push_back(130 * unit(random) - 15);
-      }
-    }
+    const std::vector<double> triangles =
+      RandomTriangles(random, 3000, 100, [](int t) { return t % 10 == 0 ? 20 : 2; });
+    const std::vector<double> points = RandomPoints(random, 3000, -15, 130);
     Check<double>(triangles, points, { 0.5, 4, 40 }, "random triangles");
   }
   {
     // Three chunks of the build (16 384 triangles each) whose triangles are far larger than the
     // ones its sample (every 61st) sees: each chunk's pairs overflow its room in the scratch.
-    std::vector<double> triangles, points;
-    for (int t = 0; t < 40000; ++t)
-    {
-      const double centre[3] = { 60 * unit(random), 60 * unit(random), 60 * unit(random) };
-      const double reach = t % 61 == 0 ? 0.01 : 3;
-      double c[9];
-      for (int k = 0; k < 9; ++k)
-      {
-        c[k] = centre[k % 3] + reach * (unit(random) - 0.5);
-      }
-      rgmc::CanonicalTriangle(c);
-      triangles.insert(triangles.end(), c, c + 9);
-    }
-    for (int q = 0; q < 600; ++q)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        points.push_back(70 * unit(random) - 5);
-      }
-    }
+    const std::vector<double> triangles =
+      RandomTriangles(random, 40000, 60, [](int t) { return t % 61 == 0 ? 0.01 : 3; });
+    const std::vector<double> points = RandomPoints(random, 600, -5, 70);
     Check<double>(triangles, points, { 1, 6 }, "larger triangles than the sample's");
   }
   {
