@@ -18,26 +18,59 @@ namespace rgmc
 namespace decimate
 {
 
+/// The corners of the block's own triangles, then of its halo, as indices into `ids`, which
+/// becomes their distinct global ids in increasing order: one sort of (id, corner) pairs, each
+/// corner then numbered as its id is first met (a search of the ids for each corner costs
+/// several times more).
+inline std::vector<int> LocalCorners(const Block& block, std::vector<std::int64_t>& ids)
+{
+  const std::size_t ownCorners = 3 * block.Own.size();
+  const std::size_t n = ownCorners + 3 * block.Halo.size();
+  auto idAt = [&block, ownCorners](std::size_t c)
+  { return c < ownCorners ? block.Own[c / 3][c % 3] : block.Halo[(c - ownCorners) / 3][c % 3]; };
+  std::vector<int> local(n);
+  ids.clear();
+  std::uint64_t last = 0;
+  auto put = [&](std::size_t, std::uint64_t key, std::size_t c)
+  {
+    if (ids.empty() || key != last)
+    {
+      ids.push_back(idAt(c));
+      last = key;
+    }
+    local[c] = static_cast<int>(ids.size() - 1);
+  };
+  // Negative ids do not fit the packed sort: they are searched for.
+  if (!rgmc::RadixSortPacked(
+        n, [&idAt](std::size_t c) { return static_cast<std::uint64_t>(idAt(c)); }, put))
+  {
+    for (std::size_t c = 0; c < n; ++c)
+    {
+      ids.push_back(idAt(c));
+    }
+    SortDistinct(ids);
+    for (std::size_t c = 0; c < n; ++c)
+    {
+      local[c] = static_cast<int>(std::lower_bound(ids.begin(), ids.end(), idAt(c)) - ids.begin());
+    }
+  }
+  return local;
+}
+
 /// The block's mesh in local indices from its triangles (by global ids) and the records in
 /// `seen`: a vertex of its own triangles that a halo triangle has too is shared with another
 /// block, so fixed. Its quadrics are summed here in the first pass, and carried after.
 inline void AssembleMesh(Block& block, const VertexTable& seen, bool areaWeighted)
 {
   rgmc::DecimationBlock& mesh = block.Mesh;
-  for (const auto* list : { &block.Own, &block.Halo })
-  {
-    for (const Triangle& t : *list)
-    {
-      mesh.Ids.insert(mesh.Ids.end(), t.begin(), t.end());
-    }
-  }
-  SortDistinct(mesh.Ids);
+  const std::vector<int> local = LocalCorners(block, mesh.Ids);
   const std::size_t n = mesh.Ids.size();
   mesh.Points.resize(3 * n);
   mesh.Quadrics.resize(n);
+  std::ptrdiff_t at = 0;
   for (std::size_t v = 0; v < n; ++v)
   {
-    const std::ptrdiff_t at = seen.Find(mesh.Ids[v]);
+    at = seen.FindAfter(mesh.Ids[v], at); // the ids increase
     const Vertex& record = seen.Vertices[at];
     std::copy(record.Point, record.Point + 3, mesh.Points.begin() + 3 * v);
     if (seen.HasQuadrics)
@@ -45,26 +78,18 @@ inline void AssembleMesh(Block& block, const VertexTable& seen, bool areaWeighte
       mesh.Quadrics[v].Terms = seen.Quadrics[at];
     }
   }
-  auto local = [&mesh](vtkIdType id)
-  {
-    return static_cast<int>(
-      std::lower_bound(mesh.Ids.begin(), mesh.Ids.end(), id) - mesh.Ids.begin());
-  };
   std::vector<std::uint8_t> inOwn(n, 0), inHalo(n, 0);
-  for (const Triangle& t : block.Own)
+  const int* corner = local.data();
+  for (auto* list : { &mesh.Triangles, &mesh.Halo })
   {
-    mesh.Triangles.push_back({ local(t[0]), local(t[1]), local(t[2]) });
-    for (int v : mesh.Triangles.back())
+    const std::size_t count = list == &mesh.Triangles ? block.Own.size() : block.Halo.size();
+    std::vector<std::uint8_t>& in = list == &mesh.Triangles ? inOwn : inHalo;
+    list->resize(count);
+    for (auto& t : *list)
     {
-      inOwn[v] = 1;
-    }
-  }
-  for (const Triangle& t : block.Halo)
-  {
-    mesh.Halo.push_back({ local(t[0]), local(t[1]), local(t[2]) });
-    for (int v : mesh.Halo.back())
-    {
-      inHalo[v] = 1;
+      t = { corner[0], corner[1], corner[2] };
+      in[t[0]] = in[t[1]] = in[t[2]] = 1;
+      corner += 3;
     }
   }
   mesh.Fixed.resize(n);

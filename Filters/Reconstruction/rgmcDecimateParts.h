@@ -129,6 +129,25 @@ public:
     return at != this->Vertices.end() && at->Id == id ? at - this->Vertices.begin() : -1;
   }
 
+  /// Find for an id known to be at `from` or after it: steps of doubling length from there,
+  /// then a binary search in the last step, so ids looked up in increasing order cost the log
+  /// of the distance between them, in memory near the last.
+  std::ptrdiff_t FindAfter(vtkIdType id, std::ptrdiff_t from) const
+  {
+    const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(this->Vertices.size());
+    std::ptrdiff_t lo = std::min(from, n), step = 1;
+    while (lo + step < n && this->Vertices[lo + step].Id < id)
+    {
+      lo += step;
+      step *= 2;
+    }
+    const auto begin = this->Vertices.begin() + lo;
+    const auto end = this->Vertices.begin() + std::min(n, lo + step + 1);
+    auto at =
+      std::lower_bound(begin, end, id, [](const Vertex& v, vtkIdType key) { return v.Id < key; });
+    return at != end && at->Id == id ? at - this->Vertices.begin() : this->Find(id);
+  }
+
   /// Sorts by id and keeps one of each (copies of a vertex are equal: decimation never
   /// touches a vertex that more than one block has). In place: the records are not held twice.
   void SortDistinct()
