@@ -1,9 +1,10 @@
 // Quadric-error edge collapse on one block (see rgmcDecimation.h).
 #include "rgmcDecimation.h"
 
+#include "rgmcMinHeap.h"
+
 #include <algorithm>
 #include <cmath>
-#include <queue>
 
 namespace rgmc
 {
@@ -35,16 +36,6 @@ Quadric Quadric::OfTriangle(
     }
   }
   return q;
-}
-
-Quadric Quadric::operator+(const Quadric& other) const
-{
-  Quadric sum;
-  for (int i = 0; i < 10; ++i)
-  {
-    sum.Terms[i] = this->Terms[i] + other.Terms[i];
-  }
-  return sum;
 }
 
 double Quadric::Error(const double p[3]) const
@@ -153,19 +144,103 @@ struct Candidate
   int A, B; // A < B: the order of their global ids
   unsigned StampA, StampB;
 
-  // The queue's top is the cheapest, then the lowest (A, B).
-  bool operator<(const Candidate& other) const
+  // The queue's top: the cheapest, then the lowest (A, B). Only one candidate of an edge is
+  // current at a time (each end's stamp changes before the edge is queued again), so this is a
+  // total order on the current ones: they come out in the same order from any heap.
+  struct Cheaper
   {
-    if (this->Cost != other.Cost)
+    bool operator()(const Candidate& x, const Candidate& y) const
     {
-      return this->Cost > other.Cost;
+      if (x.Cost != y.Cost)
+      {
+        return x.Cost < y.Cost;
+      }
+      return x.A != y.A ? x.A < y.A : x.B < y.B;
     }
-    if (this->A != other.A)
+  };
+};
+
+// The live triangles around each vertex, in one pool: vertex v's are the first Count[v] of the
+// Room[v] places from Start[v]. A star that outgrows its room moves to the pool's end with twice
+// the room. One allocation for a block, where a list of its own for each vertex costs several.
+class TriangleStars
+{
+public:
+  /// Each vertex's triangles in increasing order, with room for `slack` more.
+  void Build(std::size_t vertices, const std::vector<std::array<int, 3>>& triangles, int slack)
+  {
+    this->Count.assign(vertices, 0);
+    for (const auto& t : triangles)
     {
-      return this->A > other.A;
+      ++this->Count[t[0]], ++this->Count[t[1]], ++this->Count[t[2]];
     }
-    return this->B > other.B;
+    this->Start.resize(vertices);
+    this->Room.resize(vertices);
+    std::size_t at = 0;
+    for (std::size_t v = 0; v < vertices; ++v)
+    {
+      this->Start[v] = at;
+      this->Room[v] = this->Count[v] + slack;
+      at += this->Room[v];
+      this->Count[v] = 0;
+    }
+    this->Pool.assign(at, -1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+    {
+      for (int v : triangles[t])
+      {
+        this->Pool[this->Start[v] + this->Count[v]++] = static_cast<int>(t);
+      }
+    }
   }
+
+  struct Span
+  {
+    const int* First;
+    const int* Last;
+    const int* begin() const { return this->First; }
+    const int* end() const { return this->Last; }
+    std::size_t size() const { return static_cast<std::size_t>(this->Last - this->First); }
+  };
+
+  /// v's triangles; valid until the next Push.
+  Span operator[](int v) const
+  {
+    const int* first = this->Pool.data() + this->Start[v];
+    return Span{ first, first + this->Count[v] };
+  }
+  int At(int v, int i) const { return this->Pool[this->Start[v] + i]; }
+  int Size(int v) const { return this->Count[v]; }
+
+  void Push(int v, int t)
+  {
+    if (this->Count[v] == this->Room[v])
+    {
+      const std::size_t moved = this->Pool.size();
+      this->Pool.resize(moved + 2 * static_cast<std::size_t>(this->Room[v]) + 1, -1);
+      std::copy_n(this->Pool.begin() + this->Start[v], this->Count[v], this->Pool.begin() + moved);
+      this->Start[v] = moved;
+      this->Room[v] = 2 * this->Room[v] + 1;
+    }
+    this->Pool[this->Start[v] + this->Count[v]++] = t;
+  }
+
+  /// Removes t from v's triangles, keeping the others' order.
+  void Erase(int v, int t)
+  {
+    int* first = this->Pool.data() + this->Start[v];
+    int* last = first + this->Count[v];
+    int* at = std::find(first, last, t);
+    std::copy(at + 1, last, at);
+    --this->Count[v];
+  }
+
+  void Clear(int v) { this->Count[v] = 0; }
+
+private:
+  std::vector<int> Pool;
+  std::vector<std::size_t> Start;
+  std::vector<int> Count, Room;
 };
 
 // The mutable state of one simplification.
@@ -182,14 +257,7 @@ public:
   {
     const std::size_t n = block.Ids.size();
     this->Triangles.insert(this->Triangles.end(), block.Halo.begin(), block.Halo.end());
-    this->Star.resize(n);
-    for (std::size_t t = 0; t < this->Triangles.size(); ++t)
-    {
-      for (int v : this->Triangles[t])
-      {
-        this->Star[v].push_back(static_cast<int>(t));
-      }
-    }
+    this->Star.Build(n, this->Triangles, 4);
     // Each triangle's normal before any collapse: no collapse may turn a triangle against it,
     // even in steps that each turn it less than a right angle.
     this->Initial.resize(this->Triangles.size());
@@ -201,6 +269,7 @@ public:
     this->Stamp.assign(n, 0);
     this->Gone.assign(n, 0);
     this->Movable.assign(n, 0);
+    this->Mark.assign(n, 0);
     for (std::size_t v = 0; v < n; ++v)
     {
       this->Movable[v] = !block.Fixed[v] && this->IsDisc(static_cast<int>(v));
@@ -214,10 +283,10 @@ public:
     // A candidate found invalid is dropped: it is queued again only when one of its ends
     // changes (its cost changes then too).
     this->QueueAllEdges();
-    while (!this->Queue.empty() && log.size() < this->MaximumCollapses)
+    while (!this->Queue.Empty() && log.size() < this->MaximumCollapses)
     {
-      const Candidate c = this->Queue.top();
-      this->Queue.pop();
+      const Candidate c = this->Queue.Top();
+      this->Queue.Pop();
       if (this->Gone[c.A] || this->Gone[c.B] || c.StampA != this->Stamp[c.A] ||
         c.StampB != this->Stamp[c.B])
       {
@@ -248,12 +317,14 @@ private:
   std::size_t Owned;
   double MaximumCost;
   std::size_t MaximumCollapses;
-  std::vector<std::vector<int>> Star; // the live triangles around each vertex
+  TriangleStars Star;
   std::vector<std::array<double, 3>> Initial;
   std::vector<unsigned> Stamp;
   std::vector<std::uint8_t> Gone, Movable;
-  std::priority_queue<Candidate> Queue;
-  std::vector<int> NeighboursA, NeighboursB; // scratch
+  MinHeap<Candidate, Candidate::Cheaper> Queue;
+  std::vector<int> NeighboursA; // scratch
+  std::vector<unsigned> Mark;   // per vertex: the token of the last list it was put in
+  unsigned Token = 0;
 
   const double* Point(int v) const { return this->Points.data() + 3 * v; }
 
@@ -304,21 +375,34 @@ private:
     return steps == link.size();
   }
 
-  void Neighbours(int v, std::vector<int>& out) const
+  // A token no vertex is marked with yet.
+  unsigned NextToken()
+  {
+    if (++this->Token == 0)
+    {
+      std::fill(this->Mark.begin(), this->Mark.end(), 0u);
+      this->Token = 1;
+    }
+    return this->Token;
+  }
+
+  // The vertices of v's triangles but v, each once, in the order first met, marked with a new
+  // token (a mark, not a sort: these lists are made several times a collapse).
+  void Neighbours(int v, std::vector<int>& out)
   {
     out.clear();
+    const unsigned token = this->NextToken();
     for (int t : this->Star[v])
     {
       for (int w : this->Triangles[t])
       {
-        if (w != v)
+        if (w != v && this->Mark[w] != token)
         {
+          this->Mark[w] = token;
           out.push_back(w);
         }
       }
     }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
   Candidate Evaluate(int a, int b) const
@@ -349,7 +433,7 @@ private:
         // Each edge of a consistently oriented fan once: from its lower end.
         if (p < q && this->Movable[p] && this->Movable[q])
         {
-          this->Queue.push(this->Evaluate(p, q));
+          this->Queue.Push(this->Evaluate(p, q));
         }
       }
     }
@@ -363,7 +447,7 @@ private:
     {
       if (this->Movable[w])
       {
-        this->Queue.push(v < w ? this->Evaluate(v, w) : this->Evaluate(w, v));
+        this->Queue.Push(v < w ? this->Evaluate(v, w) : this->Evaluate(w, v));
       }
     }
   }
@@ -376,7 +460,7 @@ private:
       return false;
     }
     // Each corner keeps at least three neighbours.
-    if (this->Star[opposite[0]].size() < 4 || this->Star[opposite[1]].size() < 4)
+    if (this->Star.Size(opposite[0]) < 4 || this->Star.Size(opposite[1]) < 4)
     {
       return false;
     }
@@ -407,24 +491,21 @@ private:
   // The link condition: a and b have no common neighbour but the two corners.
   bool LinkConditionHolds(int a, int b)
   {
+    // b's neighbours found among a's are marked anew, to be counted once (the token is taken
+    // first: a token taken after a's list could clear its marks when the tokens wrap).
+    const unsigned counted = this->NextToken();
     this->Neighbours(a, this->NeighboursA);
-    this->Neighbours(b, this->NeighboursB);
+    const unsigned ofA = this->Token;
     int common = 0;
-    for (std::size_t i = 0, j = 0; i < this->NeighboursA.size() && j < this->NeighboursB.size();)
+    for (int t : this->Star[b])
     {
-      if (this->NeighboursA[i] < this->NeighboursB[j])
+      for (int w : this->Triangles[t])
       {
-        ++i;
-      }
-      else if (this->NeighboursB[j] < this->NeighboursA[i])
-      {
-        ++j;
-      }
-      else
-      {
-        ++common;
-        ++i;
-        ++j;
+        if (w != b && this->Mark[w] == ofA)
+        {
+          this->Mark[w] = counted;
+          ++common;
+        }
       }
     }
     return common == 2;
@@ -472,13 +553,10 @@ private:
   {
     this->Quadrics[a] = this->Quadrics[a] + this->Quadrics[b];
     std::copy(position, position + 3, this->Points.begin() + 3 * a);
-    auto drop = [this](int v, int t)
+    // By place in b's star: pushing onto a's may move the pool.
+    for (int i = 0; i < this->Star.Size(b); ++i)
     {
-      auto& star = this->Star[v];
-      star.erase(std::find(star.begin(), star.end(), t));
-    };
-    for (int t : this->Star[b])
-    {
+      const int t = this->Star.At(b, i);
       auto& tri = this->Triangles[t];
       if (tri[0] == a || tri[1] == a || tri[2] == a)
       {
@@ -486,7 +564,7 @@ private:
         {
           if (w != b)
           {
-            drop(w, t);
+            this->Star.Erase(w, t);
           }
         }
         tri = { -1, -1, -1 };
@@ -497,10 +575,10 @@ private:
         {
           w = w == b ? a : w;
         }
-        this->Star[a].push_back(t);
+        this->Star.Push(a, t);
       }
     }
-    this->Star[b].clear();
+    this->Star.Clear(b);
     this->Gone[b] = 1;
     ++this->Stamp[a];
     ++this->Stamp[b];

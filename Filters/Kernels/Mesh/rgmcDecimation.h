@@ -28,7 +28,15 @@ struct Quadric
   /// area when `areaWeighted`; zero when degenerate.
   static Quadric OfTriangle(
     const double a[3], const double b[3], const double c[3], bool areaWeighted = false);
-  Quadric operator+(const Quadric& other) const;
+  Quadric operator+(const Quadric& other) const // inline: made for every candidate collapse
+  {
+    Quadric sum;
+    for (int i = 0; i < 10; ++i)
+    {
+      sum.Terms[i] = this->Terms[i] + other.Terms[i];
+    }
+    return sum;
+  }
   double Error(const double p[3]) const;
 };
 
