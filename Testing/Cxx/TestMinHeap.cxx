@@ -2,7 +2,9 @@
 // std::priority_queue: the same values popped in the same order under a total order, through
 // pushes and pops interleaved as the decimation makes them (many pushes after each pop), from
 // one value to heaps of tens of thousands, with many equal keys; and under an order with
-// equivalent values, every pop the least and the values popped those pushed.
+// equivalent values, every pop the least and the values popped those pushed. Both with 8-byte
+// values and with 16-byte ones, which the heap lays out so that a node's children share a cache
+// line.
 #include "rgmcCheck.h"
 #include "rgmcMinHeap.h"
 
@@ -26,9 +28,21 @@ struct Entry
   }
 };
 
+// 16 bytes, like the decimation's candidates: four fill a cache line.
+struct WideEntry
+{
+  std::int64_t Key;
+  std::int64_t Tie;
+  bool operator==(const WideEntry& other) const
+  {
+    return this->Key == other.Key && this->Tie == other.Tie;
+  }
+};
+
 struct ByKeyThenTie
 {
-  bool operator()(const Entry& x, const Entry& y) const
+  template <typename E>
+  bool operator()(const E& x, const E& y) const
   {
     return x.Key != y.Key ? x.Key < y.Key : x.Tie < y.Tie;
   }
@@ -41,18 +55,19 @@ struct ByKey
 
 // `rounds` rounds of one pop and up to `pushes` pushes, after `initial` pushes; keys below
 // `keys`, so that many are equal. Ties are distinct: the order is total.
+template <typename E>
 void CheckAgainstPriorityQueue(int initial, int rounds, int pushes, int keys, unsigned seed)
 {
   std::mt19937 random(seed);
   std::uniform_int_distribution<int> key(0, keys - 1), count(0, pushes);
-  rgmc::MinHeap<Entry, ByKeyThenTie> heap;
+  rgmc::MinHeap<E, ByKeyThenTie> heap;
   // std::priority_queue's top is the greatest: reverse the order.
-  auto after = [](const Entry& x, const Entry& y) { return ByKeyThenTie()(y, x); };
-  std::priority_queue<Entry, std::vector<Entry>, decltype(after)> expected(after);
+  auto after = [](const E& x, const E& y) { return ByKeyThenTie()(y, x); };
+  std::priority_queue<E, std::vector<E>, decltype(after)> expected(after);
   int tie = 0;
   auto push = [&]()
   {
-    const Entry e{ key(random), tie++ };
+    const E e{ key(random), tie++ };
     heap.Push(e);
     expected.push(e);
   };
@@ -63,6 +78,10 @@ void CheckAgainstPriorityQueue(int initial, int rounds, int pushes, int keys, un
   for (int r = 0; r < rounds && !expected.empty(); ++r)
   {
     RGMC_CHECK(heap.Size() == expected.size(), "sizes agree before pop " << r);
+    // The root sits three values before a cache line, where its children start.
+    const auto address = reinterpret_cast<std::uintptr_t>(&heap.Top());
+    RGMC_CHECK(sizeof(E) != 16 || address % 64 == 48,
+      "a 16-byte root at " << address % 64 << " bytes into its cache line, not 48");
     RGMC_CHECK(heap.Top() == expected.top(),
       "seed " << seed << ", pop " << r << ": key " << heap.Top().Key << " tie " << heap.Top().Tie
               << " where " << expected.top().Key << " " << expected.top().Tie << " was expected");
@@ -110,14 +129,18 @@ void CheckEquivalents(int n, unsigned seed)
 
 int main()
 {
-  CheckAgainstPriorityQueue(1, 1, 0, 1, 1);
-  CheckAgainstPriorityQueue(2, 5, 1, 2, 2);
-  for (unsigned seed = 3; seed < 13; ++seed)
+  for (int wide : { 0, 1 })
   {
-    CheckAgainstPriorityQueue(static_cast<int>(seed * seed), 200, 3, 4, seed); // small, all tied
+    auto check = wide ? CheckAgainstPriorityQueue<WideEntry> : CheckAgainstPriorityQueue<Entry>;
+    check(1, 1, 0, 1, 1);
+    check(2, 5, 1, 2, 2);
+    for (unsigned seed = 3; seed < 13; ++seed)
+    {
+      check(static_cast<int>(seed * seed), 200, 3, 4, seed); // small, all tied
+    }
+    check(30000, 20000, 14, 1000, 21); // the decimation's shape
+    check(0, 50000, 2, 1 << 30, 22);   // growing from empty, few ties
   }
-  CheckAgainstPriorityQueue(30000, 20000, 14, 1000, 21); // the decimation's shape
-  CheckAgainstPriorityQueue(0, 50000, 2, 1 << 30, 22);   // growing from empty, few ties
   CheckEquivalents(5000, 31);
   return rgmc_test::Result("TestMinHeap");
 }

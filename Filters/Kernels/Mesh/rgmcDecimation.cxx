@@ -137,25 +137,29 @@ void Cross(const double* a, const double* b, const double* c, double n[3])
   n[2] = u[0] * v[1] - u[1] * v[0];
 }
 
-// A candidate collapse in the queue; stale once either end has changed.
+// A candidate collapse in the queue: 16 bytes, so that a node's four children in the heap fill
+// one cache line. It holds no record of when it was made: it is stale when its cost is no longer
+// the edge's (see EdgeCollapser::Run).
 struct Candidate
 {
   double Cost;
-  int A, B; // A < B: the order of their global ids
-  unsigned StampA, StampB;
+  std::uint64_t Edge; // A << 32 | B, A < B: the order of their global ids
 
-  // The queue's top: the cheapest, then the lowest (A, B). Only one candidate of an edge is
-  // current at a time (each end's stamp changes before the edge is queued again), so this is a
-  // total order on the current ones: they come out in the same order from any heap.
+  Candidate() = default;
+  Candidate(double cost, int a, int b)
+    : Cost(cost)
+    , Edge(static_cast<std::uint64_t>(a) << 32 | static_cast<std::uint32_t>(b))
+  {
+  }
+  int A() const { return static_cast<int>(this->Edge >> 32); }
+  int B() const { return static_cast<int>(this->Edge & 0xffffffffu); }
+
+  // The queue's top: the cheapest, then the lowest (A, B), a total order on the keys.
   struct Cheaper
   {
     bool operator()(const Candidate& x, const Candidate& y) const
     {
-      if (x.Cost != y.Cost)
-      {
-        return x.Cost < y.Cost;
-      }
-      return x.A != y.A ? x.A < y.A : x.B < y.B;
+      return x.Cost != y.Cost ? x.Cost < y.Cost : x.Edge < y.Edge;
     }
   };
 };
@@ -266,7 +270,6 @@ public:
       const auto& tri = this->Triangles[t];
       Cross(this->Point(tri[0]), this->Point(tri[1]), this->Point(tri[2]), this->Initial[t].data());
     }
-    this->Stamp.assign(n, 0);
     this->Gone.assign(n, 0);
     this->Movable.assign(n, 0);
     this->Mark.assign(n, 0);
@@ -287,25 +290,33 @@ public:
     {
       const Candidate c = this->Queue.Top();
       this->Queue.Pop();
-      if (this->Gone[c.A] || this->Gone[c.B] || c.StampA != this->Stamp[c.A] ||
-        c.StampB != this->Stamp[c.B])
-      {
-        continue;
-      }
+      // Every candidate left costs at least this one.
       if (this->MaximumCost >= 0.0 && c.Cost > this->MaximumCost)
       {
         break;
       }
-      double position[3];
-      this->Place(c.A, c.B, position);
-      if (!this->CanCollapse(c.A, c.B, position))
+      const int a = c.A(), b = c.B();
+      if (this->Gone[a] || this->Gone[b])
       {
         continue;
       }
-      this->CollapseEdge(c.A, c.B, position);
+      // An edge is queued again, with its new cost, whenever an end changes. A candidate whose
+      // cost is no longer the edge's is stale; one whose cost is still the edge's has the same
+      // key as the edge's current candidate, so taking it here is taking that one (the cost is
+      // computed the same way, to the bit, each time).
+      double position[3];
+      if (this->Place(a, b, position) != c.Cost)
+      {
+        continue;
+      }
+      if (!this->CanCollapse(a, b, position))
+      {
+        continue;
+      }
+      this->CollapseEdge(a, b, position);
       level = std::max(level, c.Cost);
-      log.push_back(Collapse{ c.B, c.A, { position[0], position[1], position[2] }, level });
-      this->QueueEdgesAround(c.A);
+      log.push_back(Collapse{ b, a, { position[0], position[1], position[2] }, level });
+      this->QueueEdgesAround(a);
     }
     return log;
   }
@@ -319,7 +330,6 @@ private:
   std::size_t MaximumCollapses;
   TriangleStars Star;
   std::vector<std::array<double, 3>> Initial;
-  std::vector<unsigned> Stamp;
   std::vector<std::uint8_t> Gone, Movable;
   MinHeap<Candidate, Candidate::Cheaper> Queue;
   std::vector<int> NeighboursA; // scratch
@@ -408,7 +418,7 @@ private:
   Candidate Evaluate(int a, int b) const
   {
     double position[3];
-    return Candidate{ this->Place(a, b, position), a, b, this->Stamp[a], this->Stamp[b] };
+    return Candidate(this->Place(a, b, position), a, b);
   }
 
   // The merged vertex of a and b: see PlaceCollapse.
@@ -580,8 +590,6 @@ private:
     }
     this->Star.Clear(b);
     this->Gone[b] = 1;
-    ++this->Stamp[a];
-    ++this->Stamp[b];
   }
 };
 
