@@ -193,7 +193,7 @@ std::vector<std::vector<T>> Ranks::ExchangeAny(const std::vector<std::vector<T>>
       for (vtkIdType at = 0; at < count; at += MaxChunk)
       {
         const vtkIdType length = std::min(MaxChunk, count - at);
-        static_assert(sizeof(T) == sizeof(std::uint64_t), "messages carry 64-bit values");
+        static_assert(sizeof(T) <= sizeof(std::uint64_t), "the drain holds MaxChunk values");
         T* drain = reinterpret_cast<T*>(this->Drain.get());
         if (!target && !drain)
         {
@@ -247,6 +247,18 @@ std::vector<std::vector<double>> Ranks::Exchange(
   const std::vector<std::vector<double>>& outgoing, const std::vector<bool>& partners, int tag)
 {
   return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag);
+}
+
+std::vector<std::vector<double>> Ranks::Exchange(
+  std::vector<std::vector<double>>&& outgoing, const std::vector<bool>& partners, int tag)
+{
+  return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag, &outgoing);
+}
+
+std::vector<std::vector<float>> Ranks::Exchange(
+  std::vector<std::vector<float>>&& outgoing, const std::vector<bool>& partners, int tag)
+{
+  return this->ExchangeAny(outgoing, this->TournamentOrder(partners), tag, &outgoing);
 }
 
 std::vector<std::vector<vtkIdType>> Ranks::ExchangeInOrder(

@@ -107,9 +107,14 @@ public:
   std::vector<std::vector<vtkIdType>> Exchange(
     std::vector<std::vector<vtkIdType>>&& outgoing, const std::vector<bool>& partners, int tag);
 
-  /// Exchange for doubles.
+  /// Exchange for doubles, and for floats (half the bytes for values that are floats anyway);
+  /// copying or consuming `outgoing`.
   std::vector<std::vector<double>> Exchange(
     const std::vector<std::vector<double>>& outgoing, const std::vector<bool>& partners, int tag);
+  std::vector<std::vector<double>> Exchange(
+    std::vector<std::vector<double>>&& outgoing, const std::vector<bool>& partners, int tag);
+  std::vector<std::vector<float>> Exchange(
+    std::vector<std::vector<float>>&& outgoing, const std::vector<bool>& partners, int tag);
 
   /// Exchange with the ranks of `order` only, one after the other in that order, which the
   /// ranks must have agreed to be deadlock-free (rgmc::Ownership::MeetingOrder): messages go to

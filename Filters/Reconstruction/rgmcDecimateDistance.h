@@ -40,6 +40,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -112,6 +113,9 @@ struct DistanceSurface
       f(this->FloatTriangles);
     }
   }
+
+  /// Whether the triangles are held as doubles (1) or as floats, or there are none (0).
+  std::int64_t HasDoubleTriangles() const { return this->Triangles.empty() ? 0 : 1; }
 
   std::int64_t TriangleCount() const
   {
@@ -366,12 +370,38 @@ std::vector<double> MeasureWithin(const Points& points, const Triangles& triangl
   return unresolved;
 }
 
+/// The parts one after the other, the largest moved rather than copied (the order of the
+/// values does not change the distances).
+template <typename T>
+std::vector<T> Concatenate(std::vector<std::vector<T>>&& parts)
+{
+  std::size_t largest = 0, total = 0;
+  for (std::size_t i = 0; i < parts.size(); ++i)
+  {
+    largest = parts[i].size() > parts[largest].size() ? i : largest;
+    total += parts[i].size();
+  }
+  std::vector<T> all;
+  if (!parts.empty())
+  {
+    all.swap(parts[largest]);
+  }
+  all.reserve(total);
+  for (auto& part : parts)
+  {
+    all.insert(all.end(), part.begin(), part.end());
+    std::vector<T>().swap(part);
+  }
+  return all;
+}
+
 inline bool ReduceDirected(Ranks& ranks, DirectedDistance& result, std::string& problem);
 
 /// The distances from `from`'s vertices to `to`'s triangles, over all ranks (collective).
+/// `floats`: every rank's `to` holds its triangles as floats (or none).
 inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const DistanceSurface& to,
-  const DistanceCells& cells, double radius, double bucket, double extent, DirectedDistance& result,
-  std::string& problem)
+  bool floats, const DistanceCells& cells, double radius, double bucket, double extent,
+  DirectedDistance& result, std::string& problem)
 {
   const int size = ranks.Size;
   if (size == 1) // every triangle is here: one search, without copies
@@ -391,22 +421,24 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
   std::vector<bool> everyone(static_cast<std::size_t>(size), true);
   // Round 0: every vertex to its cell's rank; later rounds: the far ones stay where they are.
   std::vector<std::vector<double>> outgoing(static_cast<std::size_t>(size));
+  for (auto& part : outgoing)
+  {
+    part.reserve(from.Points.size() / static_cast<std::size_t>(size) * 5 / 4);
+  }
   for (std::size_t i = 0; i < from.Points.size(); i += 3)
   {
     const double* p = from.Points.data() + i;
     auto& to_ = outgoing[cells.RankOf(cells.CellOf(p))];
     to_.insert(to_.end(), p, p + 3);
   }
-  std::vector<double> mine;
-  for (const auto& part : ranks.Exchange(outgoing, everyone, DistancePointsTag))
-  {
-    mine.insert(mine.end(), part.begin(), part.end());
-  }
+  std::vector<double> mine =
+    Concatenate(ranks.Exchange(std::move(outgoing), everyone, DistancePointsTag));
   for (double r = radius;; r *= 8)
   {
     const bool all = r >= extent; // every triangle goes to every rank that still has vertices
     // The cells with vertices still to measure, known to every rank.
     std::vector<vtkIdType> wanted;
+    wanted.reserve(mine.size() / 3);
     for (std::size_t i = 0; i < mine.size(); i += 3)
     {
       wanted.push_back(cells.CellOf(mine.data() + i));
@@ -415,40 +447,58 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
     wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
     std::vector<std::vector<vtkIdType>> told(static_cast<std::size_t>(size), wanted);
     const auto cellsOf = ranks.Exchange(told, everyone, DistanceCellsTag);
-    std::vector<std::vector<vtkIdType>> sorted(cellsOf.begin(), cellsOf.end());
-    std::vector<std::vector<double>> triangles(static_cast<std::size_t>(size));
+    const std::vector<std::vector<vtkIdType>> sorted(cellsOf.begin(), cellsOf.end());
+    // The triangles travel as floats where every rank's are floats (half the bytes, the same
+    // values), as doubles otherwise: the ranks agree on the type (DecimationDistance).
+    auto route = [&](const auto& corners, auto zero)
+    {
+      using Value = decltype(zero);
+      std::vector<std::vector<Value>> triangles(static_cast<std::size_t>(size));
+      if (r == radius) // the first round sends about each rank's share, and a little more
+      {
+        for (auto& part : triangles)
+        {
+          part.reserve(corners.size() / static_cast<std::size_t>(size) * 5 / 4);
+        }
+      }
+      std::vector<std::size_t> sentAt(static_cast<std::size_t>(size), corners.size());
+      for (std::size_t t = 0; t < corners.size(); t += 9)
+      {
+        const auto* c = corners.data() + t;
+        double lo[3], hi[3];
+        TriangleBox(c, lo, hi);
+        cells.ForCellsNear(lo, hi, all ? extent : r,
+          [&](std::int64_t cell)
+          {
+            const int owner = cells.RankOf(cell);
+            if (sentAt[owner] != t &&
+              std::binary_search(sorted[owner].begin(), sorted[owner].end(), cell))
+            {
+              sentAt[owner] = t;
+              triangles[owner].insert(triangles[owner].end(), c, c + 9);
+            }
+          });
+      }
+      const std::vector<Value> near =
+        Concatenate(ranks.Exchange(std::move(triangles), everyone, DistanceTrianglesTag));
+      TryLocally(problem, "measure the distances",
+        [&]()
+        {
+          mine = MeasureWithin(
+            mine, near, bucket, all ? std::numeric_limits<double>::infinity() : r, result);
+        });
+    };
     to.WithTriangles(
       [&](const auto& corners)
       {
-        for (std::size_t t = 0; t < corners.size(); t += 9)
+        if (floats)
         {
-          const auto* c = corners.data() + t;
-          double lo[3], hi[3];
-          TriangleBox(c, lo, hi);
-          std::vector<int> sentTo;
-          cells.ForCellsNear(lo, hi, all ? extent : r,
-            [&](std::int64_t cell)
-            {
-              const int owner = cells.RankOf(cell);
-              if (std::binary_search(sorted[owner].begin(), sorted[owner].end(), cell) &&
-                std::find(sentTo.begin(), sentTo.end(), owner) == sentTo.end())
-              {
-                sentTo.push_back(owner);
-                triangles[owner].insert(triangles[owner].end(), c, c + 9);
-              }
-            });
+          route(corners, 0.0f);
         }
-      });
-    std::vector<double> near;
-    for (const auto& part : ranks.Exchange(triangles, everyone, DistanceTrianglesTag))
-    {
-      near.insert(near.end(), part.begin(), part.end());
-    }
-    TryLocally(problem, "measure the distances",
-      [&]()
-      {
-        mine = MeasureWithin(
-          mine, near, bucket, all ? std::numeric_limits<double>::infinity() : r, result);
+        else
+        {
+          route(corners, 0.0);
+        }
       });
     std::int64_t left = static_cast<std::int64_t>(mine.size() / 3), anyLeft = 0;
     ranks.AllReduce(&left, &anyLeft, 1, vtkCommunicator::SUM_OP, "counting the far vertices");
@@ -508,8 +558,11 @@ inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* ou
     box[3 + k] = -std::max(a->Hi[k], b->Hi[k]);
   }
   ranks.AllReduce(box, global, 6, vtkCommunicator::MIN_OP, "the surfaces' box");
-  std::int64_t counts[2] = { a->TriangleCount(), b->TriangleCount() }, totals[2];
-  ranks.AllReduce(counts, totals, 2, vtkCommunicator::SUM_OP, "the triangle counts");
+  // The triangle counts, and how many ranks hold each surface's triangles as doubles.
+  std::int64_t counts[4] = { a->TriangleCount(), b->TriangleCount(), a->HasDoubleTriangles(),
+    b->HasDoubleTriangles() },
+               totals[4];
+  ranks.AllReduce(counts, totals, 4, vtkCommunicator::SUM_OP, "the triangle counts");
   if (!ranks.Agree(true, problem))
   {
     return false;
@@ -544,10 +597,10 @@ inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* ou
   // report's work 1.04 s against 1.24 s on the 512^3 skull, one thread).
   const double bucket = 2 * diagonal /
     std::sqrt(std::max(1.0, 0.5 * static_cast<double>(std::min(totals[0], totals[1]))));
-  if (!MeasureDirected(
-        ranks, *a, *b, cells, radiusFor(totals[1]), bucket, 2 * diagonal, there, problem) ||
-    !MeasureDirected(
-      ranks, *b, *a, cells, radiusFor(totals[0]), bucket, 2 * diagonal, back, problem))
+  if (!MeasureDirected(ranks, *a, *b, totals[3] == 0, cells, radiusFor(totals[1]), bucket,
+        2 * diagonal, there, problem) ||
+    !MeasureDirected(ranks, *b, *a, totals[2] == 0, cells, radiusFor(totals[0]), bucket,
+      2 * diagonal, back, problem))
   {
     return false;
   }
