@@ -5,18 +5,16 @@
 #include "vtkRGArrays.h"
 #include "vtkRGCollective.h"
 #include "vtkRGMessage.h"
+#include "vtkRGPieces.h"
 #include "vtkRGRunController.h"
 
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
-#include "vtkExtentTranslator.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
-#include "vtkInformationIntegerRequestKey.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
-#include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkShortArray.h"
 #include "vtkSmartPointer.h"
@@ -151,53 +149,10 @@ int vtkRGVolumeReader::RequestInformation(
   vtkDataObject::SetPointDataActiveScalarInfo(
     outInfo, this->OutputScalarType, this->NumberOfComponents);
   // Pieces are slabs of whole slices, so that a rank reads only the files (or the bytes) of its
-  // slices. The reader splits the volume itself (CAN_HANDLE_PIECE_REQUEST) rather than letting
-  // the executive do it (CAN_PRODUCE_SUB_EXTENT with a Z_SLAB_MODE split): VTK 9.2's executive
-  // would cut the extent in slabs but then regenerate the ghost arrays for a BLOCK_MODE split,
-  // marking as ghosts cells that no rank owns (half of each piece, for a volume whose longest
-  // side is not z).
+  // slices; the reader splits the volume itself (rgmc::SlabPiece says why).
   outInfo->Remove(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT());
   outInfo->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
   return 1;
-}
-
-//------------------------------------------------------------------------------
-bool vtkRGVolumeReader::PieceExtent(vtkInformation* outInfo, int extent[6], int owned[6]) const
-{
-  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
-    this->Dimensions[2] - 1 };
-  const int piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    : 0;
-  const int pieces = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
-    : 1;
-  const int ghosts = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS())
-    : 0;
-  vtkNew<vtkExtentTranslator> translator;
-  if (pieces < 1 || piece < 0 || piece >= pieces ||
-    !translator->PieceToExtentThreadSafe(
-      piece, pieces, 0, const_cast<int*>(whole), owned, vtkExtentTranslator::Z_SLAB_MODE, 0))
-  {
-    return false; // more pieces than slices: this one is empty
-  }
-  translator->PieceToExtentThreadSafe(
-    piece, pieces, ghosts, const_cast<int*>(whole), extent, vtkExtentTranslator::Z_SLAB_MODE, 0);
-  // A consumer that asks for less than the whole volume (a VOI) gets the part of its slab in it.
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT()))
-  {
-    int request[6];
-    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), request);
-    for (int a = 0; a < 3; ++a)
-    {
-      extent[2 * a] = std::max(extent[2 * a], request[2 * a]);
-      extent[2 * a + 1] = std::min(extent[2 * a + 1], request[2 * a + 1]);
-      owned[2 * a] = std::max(owned[2 * a], request[2 * a]);
-      owned[2 * a + 1] = std::min(owned[2 * a + 1], request[2 * a + 1]);
-    }
-  }
-  return extent[0] <= extent[1] && extent[2] <= extent[3] && extent[4] <= extent[5];
 }
 
 //------------------------------------------------------------------------------
@@ -210,7 +165,9 @@ int vtkRGVolumeReader::RequestData(
   vtkImageData* output = vtkImageData::GetData(outInfo);
 
   int extent[6] = { 0, -1, 0, -1, 0, -1 }, owned[6] = { 0, -1, 0, -1, 0, -1 };
-  const bool empty = !this->PieceExtent(outInfo, extent, owned);
+  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
+    this->Dimensions[2] - 1 };
+  const bool empty = !rgmc::SlabPiece(outInfo, whole, extent, owned);
   if (this->OutputScalarType == 0)
   {
     // The header scan failed on every rank (its status was agreed): no collective here, since
@@ -271,10 +228,7 @@ int vtkRGVolumeReader::RequestData(
     output->GetPointData()->SetScalars(scalars);
     // Mark the ghost layers the pipeline asked for, as ParaView's image sources do, so that
     // filters know which cells this rank owns.
-    if (!std::equal(extent, extent + 6, owned))
-    {
-      output->GenerateGhostArray(owned);
-    }
+    rgmc::MarkGhosts(output, owned);
   }
   return 1;
 }

@@ -106,10 +106,6 @@ protected:
    */
   virtual bool ReadExtent(const int extent[6], vtkDataArray* scalars, std::string& message) = 0;
 
-  /// The extent of the piece the pipeline asks for (its slab of slices with the ghost layers,
-  /// within any requested update extent) and the part of it this rank owns; false when the
-  /// piece is empty.
-  bool PieceExtent(vtkInformation* outInfo, int extent[6], int owned[6]) const;
 
   /**
    * The output type for samples `slope * stored + intercept`: int16 when every such value is an

@@ -175,4 +175,16 @@ void CacheRanges(vtkDataArray* array)
   }
 }
 
+void StoreRange(vtkDataArray* array, const double range[2])
+{
+  vtkNew<vtkInformationVector> all, finite;
+  all->SetNumberOfInformationObjects(1);
+  finite->SetNumberOfInformationObjects(1);
+  all->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), range, 2);
+  finite->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), range, 2);
+  vtkInformation* info = array->GetInformation();
+  info->Set(vtkAbstractArray::PER_COMPONENT(), all);
+  info->Set(vtkAbstractArray::PER_FINITE_COMPONENT(), finite);
+}
+
 } // namespace rgmc

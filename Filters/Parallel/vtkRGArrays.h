@@ -38,6 +38,22 @@ typename ArrayT::ValueType* Allocate(ArrayT* array, vtkIdType values)
   return static_cast<Value*>(memory);
 }
 
+/// As Allocate, with every value zero: from calloc, whose large blocks are fresh pages the
+/// kernel gives zeroed when first touched, so that values left zero cost no write.
+template <typename ArrayT>
+typename ArrayT::ValueType* AllocateZeroed(ArrayT* array, vtkIdType values)
+{
+  using Value = typename ArrayT::ValueType;
+  void* memory =
+    std::calloc(std::max<std::size_t>(1, static_cast<std::size_t>(values)), sizeof(Value));
+  if (!memory)
+  {
+    throw std::bad_alloc();
+  }
+  array->SetArray(static_cast<Value*>(memory), values, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+  return static_cast<Value*>(memory);
+}
+
 /// How many cells of `polys` do not have 3 points: from the offsets, read straight when they are
 /// 32- or 64-bit arrays (as VTK's cell arrays keep them), else cell by cell.
 inline vtkIdType PolygonsNotTriangles(vtkCellArray* polys)
@@ -120,16 +136,6 @@ inline vtkIdType FirstNotFinite(vtkDataArray* array)
   return -1;
 }
 
-/// The slices [lo, hi] that a piece of `extent` shares with one of `previous` (the piece a
-/// source made before, asked for again with ghost slices): both must have the same rows and
-/// columns; false when they share none.
-inline bool SharedSlices(const int extent[6], const int previous[6], int& lo, int& hi)
-{
-  lo = std::max(extent[4], previous[4]);
-  hi = std::min(extent[5], previous[5]);
-  return std::equal(extent, extent + 4, previous) && lo <= hi;
-}
-
 /// Stores `array`'s range and finite range, per component, where VTK keeps them once computed
 /// (vtkAbstractArray::PER_COMPONENT and PER_FINITE_COMPONENT), so that GetRange,
 /// GetFiniteRange and ParaView's data information find them instead of scanning the array again
@@ -140,6 +146,10 @@ inline bool SharedSlices(const int extent[6], const int previous[6], int& lo, in
 /// nothing is stored and VTK computes as before. Call it once the values are final: VTK drops
 /// the ranges when the array is modified.
 void CacheRanges(vtkDataArray* array);
+
+/// Stores `range` as the range and finite range of `array`, of one component, whose values its
+/// maker knows without a scan (the keys CacheRanges sets: the caller answers for them).
+void StoreRange(vtkDataArray* array, const double range[2]);
 
 } // namespace rgmc
 

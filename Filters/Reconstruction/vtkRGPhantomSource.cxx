@@ -5,6 +5,7 @@
 #include "rgmcPhantomNoise.h"
 #include "vtkRGArrays.h"
 #include "vtkRGParallel.h"
+#include "vtkRGPieces.h"
 
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -253,7 +254,9 @@ int vtkRGPhantomSource::RequestInformation(
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
   outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
   outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
-  outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
+  // A piece per rank in slabs, its ghost slices marked here (rgmc::SlabPiece says why).
+  outInfo->Remove(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT());
+  outInfo->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
   vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_SHORT, 1);
   return 1;
 }
@@ -265,16 +268,32 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
   {
     this->LastPiece = nullptr; // changed since: of no use, and not to be held while allocating
   }
-  vtkImageData* image = this->AllocateOutputData(output, outInfo);
-  vtkShortArray* hu = vtkShortArray::SafeDownCast(image->GetPointData()->GetScalars());
-  if (!hu)
+  vtkImageData* image = vtkImageData::SafeDownCast(output);
+  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
+    this->Dimensions[2] - 1 };
+  int ext[6], owned[6];
+  image->Initialize();
+  image->SetSpacing(outInfo->Get(vtkDataObject::SPACING()));
+  image->SetOrigin(outInfo->Get(vtkDataObject::ORIGIN()));
+  if (!rgmc::SlabPiece(outInfo, whole, ext, owned))
   {
-    vtkErrorMacro(<< "Could not allocate the int16 output array.");
+    return; // more pieces than slices: this one is empty
+  }
+  image->SetExtent(ext);
+  auto hu = vtkSmartPointer<vtkShortArray>::New();
+  hu->SetName("HU");
+  try
+  {
+    rgmc::Allocate(hu.Get(), image->GetNumberOfPoints());
+  }
+  catch (const std::bad_alloc&)
+  {
+    image->Initialize();
+    vtkErrorMacro(<< "Could not allocate the int16 output array of " << image->GetNumberOfPoints()
+                  << " voxels.");
     return;
   }
-  hu->SetName("HU");
-  int ext[6];
-  image->GetExtent(ext);
+  image->GetPointData()->SetScalars(hu);
   double origin[3], spacing[3];
   image->GetOrigin(origin);
   image->GetSpacing(spacing);
@@ -284,7 +303,7 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
   // The slices shared with the piece made last, when nothing has changed since, are copied.
   int lo, hi;
   vtkSmartPointer<vtkShortArray> previous;
-  if (this->LastPiece && this->LastPiece != hu && rgmc::SharedSlices(ext, this->LastExtent, lo, hi))
+  if (this->LastPiece && rgmc::SharedSlices(ext, this->LastExtent, lo, hi))
   {
     previous = this->LastPiece;
   }
@@ -334,6 +353,7 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
     this->MadeTime.Modified();
   }
   rgmc::CacheRanges(hu);
+  rgmc::MarkGhosts(image, owned);
 }
 
 //------------------------------------------------------------------------------

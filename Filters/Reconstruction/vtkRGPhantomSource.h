@@ -10,9 +10,9 @@
  * makes them in a real scanner.
  *
  * The field of view (default 240 mm) is centred on the origin; spacing is FieldOfView /
- * Dimensions. Every sample depends only on its global index and RandomSeed, so any piece (the
- * source produces sub-extents) is identical to the same region of the whole volume: ranks can
- * generate their own pieces in parallel.
+ * Dimensions. Every sample depends only on its global index and RandomSeed, so any piece (a
+ * slab of slices per rank, with the ghost slices asked for, or any sub-extent asked for) is
+ * identical to the same region of the whole volume: ranks generate their own pieces in parallel.
  *
  * World coordinates of useful seeds (mm): the top of the skull (0, 0, 105); the mandible
  * (0, 65, -75); the lowest vertebra (0, -20, -96).

@@ -136,12 +136,15 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
   RGMC_CHECK(r.Ok && r.Errors.empty(), what << ": " << r.Errors);
   RGMC_CHECK(r.Warnings.empty(), what << ": unexpected warnings " << r.Warnings);
 
-  // A slab of whole slices, ParaView's piece in Z_SLAB mode, decoded from its own files only.
+  // A slab of whole slices, ParaView's piece in Z_SLAB mode, decoded from its own files only;
+  // on several ranks with the ghost slice the extraction asks for, asked for or not.
   const int wholeExtent[6] = { 0, Dims[0] - 1, 0, Dims[1] - 1, 0, Dims[2] - 1 };
-  int expected[6];
+  int owned[6], expected[6];
   vtkNew<vtkExtentTranslator> translator;
   translator->PieceToExtentThreadSafe(
-    rank, ranks, 0, const_cast<int*>(wholeExtent), expected, vtkExtentTranslator::Z_SLAB_MODE, 0);
+    rank, ranks, 0, const_cast<int*>(wholeExtent), owned, vtkExtentTranslator::Z_SLAB_MODE, 0);
+  translator->PieceToExtentThreadSafe(rank, ranks, ranks > 1 ? 1 : 0, const_cast<int*>(wholeExtent),
+    expected, vtkExtentTranslator::Z_SLAB_MODE, 0);
   int ext[6];
   r.Image->GetExtent(ext);
   for (int a = 0; a < 6; ++a)
@@ -155,9 +158,10 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
          << slices << " slices");
   int filesRead = reader->GetNumberOfFilesRead(), totalRead = 0;
   controller->AllReduce(&filesRead, &totalRead, 1, vtkCommunicator::SUM_OP);
-  // Neighbouring pieces share one plane of points (every cell in one piece): N - 1 slices twice.
-  RGMC_CHECK(
-    totalRead == Dims[2] + ranks - 1, what << ": " << totalRead << " files decoded over all ranks");
+  // Neighbouring pieces share one plane of points (every cell in one piece), and each holds the
+  // next plane of the other as its ghost slice: N - 1 slices twice and 2 (N - 1) ghosts.
+  RGMC_CHECK(totalRead == Dims[2] + 3 * (ranks - 1),
+    what << ": " << totalRead << " files decoded over all ranks");
 
   // Voxels: the phantom's exactly (the generator's rescale stores every HU exactly).
   vtkDataArray* scalars = r.Image->GetPointData()->GetScalars();
@@ -187,15 +191,15 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
     }
   }
 
-  // The union of the pieces is the 1-rank volume: same checksum, same values at every index.
-  // Neighbouring slabs share a slice: it counts for the lower one.
-  auto checksum = [](vtkImageData* image, bool sharedTop)
+  // The union of the owned parts is the 1-rank volume: same checksum, same values at every
+  // index. Neighbouring slabs share a slice: it counts for the lower one.
+  auto checksum = [](vtkImageData* image, int first, int last)
   {
     int e[6];
     image->GetExtent(e);
     vtkDataArray* a = image->GetPointData()->GetScalars();
     double total = 0;
-    for (int k = e[4]; a && k <= e[5] - (sharedTop ? 1 : 0); ++k)
+    for (int k = first; a && k <= last; ++k)
     {
       for (int j = e[2]; j <= e[3]; ++j)
       {
@@ -208,7 +212,7 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
     }
     return total;
   };
-  double sum = checksum(r.Image, ext[5] < Dims[2] - 1), total = 0;
+  double sum = checksum(r.Image, owned[4], owned[5] - (owned[5] < Dims[2] - 1 ? 1 : 0)), total = 0;
   controller->AllReduce(&sum, &total, 1, vtkCommunicator::SUM_OP);
   if (rank == 0)
   {
@@ -217,8 +221,8 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
     PieceRead all = ReadPiece(one, 0, 1, 0);
     RGMC_CHECK(all.Ok, what << ": 1-rank read failed " << all.Errors);
     RGMC_CHECK(Mismatches(all.Image, whole) == 0, what << ": the 1-rank volume differs");
-    RGMC_CHECK(checksum(all.Image, false) == total,
-      what << ": checksum " << total << " over the ranks, " << checksum(all.Image, false)
+    RGMC_CHECK(checksum(all.Image, 0, Dims[2] - 1) == total,
+      what << ": checksum " << total << " over the ranks, " << checksum(all.Image, 0, Dims[2] - 1)
            << " on 1 rank");
     std::cout << what << ": " << reader->GetSummary() << "; rank 0 decoded "
               << reader->GetNumberOfFilesRead() << " of " << Dims[2] << " files\n";
@@ -234,21 +238,29 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
       points += piece->GetNumberOfPoints();
       differ += Mismatches(piece, whole);
     }
-    RGMC_CHECK(
-      points == static_cast<vtkIdType>(Dims[0]) * Dims[1] * (Dims[2] + ranks - 1) && differ == 0,
+    RGMC_CHECK(points == static_cast<vtkIdType>(Dims[0]) * Dims[1] * (Dims[2] + 3 * (ranks - 1)) &&
+        differ == 0,
       what << ": the union of the pieces has " << points << " points, " << differ
            << " differ from 1 rank");
   }
 
-  // With one ghost level a piece reaches one slice further on each inner side.
-  PieceRead g = ReadPiece(reader, rank, ranks, 1);
+  // The extraction's request for one ghost level finds the piece made: it is not read again.
+  const vtkMTimeType made = reader->GetOutputDataObject(0)->GetMTime();
+  PieceRead one = ReadPiece(reader, rank, ranks, 1);
+  one.Image->GetExtent(ext);
+  RGMC_CHECK(one.Ok && reader->GetOutputDataObject(0)->GetMTime() == made &&
+      std::equal(ext, ext + 6, expected),
+    what << ": asked for with one ghost level, rank " << rank << "'s piece was made again");
+  // With two ghost levels a piece reaches one slice further on each inner side.
+  PieceRead g = ReadPiece(reader, rank, ranks, 2);
   int gext[6];
   g.Image->GetExtent(gext);
-  RGMC_CHECK(g.Ok && gext[4] == std::max(0, expected[4] - 1) &&
-      gext[5] == std::min(Dims[2] - 1, expected[5] + 1),
+  const int levels = ranks > 1 ? 2 : 0;
+  RGMC_CHECK(g.Ok && gext[4] == std::max(0, owned[4] - levels) &&
+      gext[5] == std::min(Dims[2] - 1, owned[5] + levels),
     what << ": ghost extent " << gext[4] << ".." << gext[5]);
   RGMC_CHECK(Mismatches(g.Image, whole) == 0, what << ": ghost slices differ");
-  // The slices it held already are copied: only the ghost layers' files are decoded (on one
+  // The slices it held already are copied: only the new ghost layers' files are decoded (on one
   // rank there are none, and the pipeline does not run the reader again).
   const int ghostSlices = (gext[5] - gext[4]) - (expected[5] - expected[4]);
   RGMC_CHECK(ghostSlices == 0 || reader->GetNumberOfFilesRead() == ghostSlices,
@@ -256,7 +268,7 @@ void ReadGoodSeries(vtkMultiProcessController* controller, const std::string& di
          << ghostSlices << " ghost slices");
   // A changed reader reads everything again.
   reader->Modified();
-  PieceRead again = ReadPiece(reader, rank, ranks, 1);
+  PieceRead again = ReadPiece(reader, rank, ranks, 2);
   RGMC_CHECK(again.Ok && Mismatches(again.Image, whole) == 0 &&
       reader->GetNumberOfFilesRead() == gext[5] - gext[4] + 1,
     what << ": after a change, rank " << rank << " decoded " << reader->GetNumberOfFilesRead()
