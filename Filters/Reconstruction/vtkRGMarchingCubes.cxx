@@ -39,6 +39,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
+#include <chrono>
 #include <functional>
 #include <limits>
 #include <map>
@@ -248,12 +249,18 @@ int vtkRGMarchingCubes::RequestData(
   rgmc::ForgetEarlierAbort(this->AbortExecute);
   rgmc::RunController controller(this->Controller);
   Run run(controller);
-  // The counts of this run, however it ends.
+  // The counts and the time of this run, however it ends.
   struct Accounting
   {
     vtkRGMarchingCubes* Filter;
     Run& Counted;
-    ~Accounting() { this->Filter->Account(this->Counted); }
+    std::chrono::steady_clock::time_point Started = std::chrono::steady_clock::now();
+    ~Accounting()
+    {
+      this->Filter->ExtractionSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - this->Started).count();
+      this->Filter->Account(this->Counted);
+    }
   } accounting{ this, run };
 
   // PASS 0: check the input on every rank and agree on the verdict.

@@ -187,6 +187,12 @@ public:
   vtkGetMacro(NumberOfTrianglesMade, vtkIdType);
   ///@}
 
+  /**
+   * Wall seconds of the last run on this rank, from the start of RequestData to its end (the
+   * input's update not included).
+   */
+  vtkGetMacro(ExtractionSeconds, double);
+
   ///@{
   /**
    * The controller that links the ranks. Defaults to the global controller; a single process
@@ -221,6 +227,7 @@ protected:
   vtkIdType NumberOfCubesExamined = 0;
   vtkIdType NumberOfFacePointsRead = 0;
   vtkIdType NumberOfTrianglesMade = 0;
+  double ExtractionSeconds = 0;
 
 private:
   vtkRGMarchingCubes(const vtkRGMarchingCubes&) = delete;

@@ -69,6 +69,10 @@ def main():
         check(expected in result.stdout, "the summary says %r" % expected)
     report = json.load(open(prefix + ".json"))
     check(report["triangles"] > 10000, "the skull has many triangles: %d" % report["triangles"])
+    # The extraction as the filter timed it: part of reading and extracting, never nothing.
+    check(0 < report["extract_seconds"] <= report["total_seconds"],
+          "the extraction's %s s within read and extract's %s s" % (
+              report["extract_seconds"], report["total_seconds"]))
     check(stl_triangles(prefix + ".stl") == report["triangles"], "the STL holds every triangle")
     check(os.path.getsize(prefix + ".vtp") > 1000, "a VTP is written")
     if args.xvfb_run:
@@ -87,6 +91,9 @@ def main():
                              "--output", prefix + "-2", "--ranks", "2", "--formats", "stl,ply,vtp"])
     check(result.returncode == 0, "the pipeline succeeds on 2 ranks")
     report2 = json.load(open(prefix + "-2.json"))
+    check(0 < report2["extract_seconds"] <= report2["total_seconds"],
+          "2 ranks: the extraction's %s s within read and extract's %s s" % (
+              report2["extract_seconds"], report2["total_seconds"]))
     check(report2["ranks"] == 2 and report2["triangles"] == report["triangles"],
           "2 ranks give the same triangles: %d vs %d" % (report2["triangles"], report["triangles"]))
     check(report2["checks"] == checks, "2 ranks give the same mesh checks: %s" % report2["checks"])
