@@ -10,6 +10,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkSMPTools.h"
@@ -262,25 +263,21 @@ int vtkRGPhantomSource::RequestInformation(
 }
 
 //------------------------------------------------------------------------------
-void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo)
+vtkShortArray* vtkRGPhantomSource::AllocatePiece(
+  vtkImageData* image, vtkInformation* outInfo, int owned[6])
 {
-  if (this->MadeTime < this->GetMTime())
-  {
-    this->LastPiece = nullptr; // changed since: of no use, and not to be held while allocating
-  }
-  vtkImageData* image = vtkImageData::SafeDownCast(output);
   const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
     this->Dimensions[2] - 1 };
-  int ext[6], owned[6];
+  int ext[6];
   image->Initialize();
   image->SetSpacing(outInfo->Get(vtkDataObject::SPACING()));
   image->SetOrigin(outInfo->Get(vtkDataObject::ORIGIN()));
   if (!rgmc::SlabPiece(outInfo, whole, ext, owned))
   {
-    return; // more pieces than slices: this one is empty
+    return nullptr; // more pieces than layers: this one is empty
   }
   image->SetExtent(ext);
-  auto hu = vtkSmartPointer<vtkShortArray>::New();
+  vtkNew<vtkShortArray> hu;
   hu->SetName("HU");
   try
   {
@@ -291,9 +288,28 @@ void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkIn
     image->Initialize();
     vtkErrorMacro(<< "Could not allocate the int16 output array of " << image->GetNumberOfPoints()
                   << " voxels.");
-    return;
+    return nullptr;
   }
   image->GetPointData()->SetScalars(hu);
+  return hu.Get(); // held by the image
+}
+
+//------------------------------------------------------------------------------
+void vtkRGPhantomSource::ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo)
+{
+  if (this->MadeTime < this->GetMTime())
+  {
+    this->LastPiece = nullptr; // changed since: of no use, and not to be held while allocating
+  }
+  vtkImageData* image = vtkImageData::SafeDownCast(output);
+  int owned[6];
+  vtkShortArray* hu = this->AllocatePiece(image, outInfo, owned);
+  if (!hu)
+  {
+    return;
+  }
+  int ext[6];
+  image->GetExtent(ext);
   double origin[3], spacing[3];
   image->GetOrigin(origin);
   image->GetSpacing(spacing);

@@ -80,6 +80,9 @@ protected:
 
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   void ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo) override;
+  /// Sets `image` to the piece `outInfo` asks for (rgmc::SlabPiece), with `owned`, and gives it
+  /// its HU array, allocated; nullptr when the piece is empty or memory is short (with an error).
+  vtkShortArray* AllocatePiece(vtkImageData* image, vtkInformation* outInfo, int owned[6]);
 
   int Dimensions[3] = { 128, 128, 128 };
   double FieldOfView = 240.0;
