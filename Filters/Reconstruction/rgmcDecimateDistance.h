@@ -3,8 +3,10 @@
 // vertex of each (each global vertex once: the copies Seam Repair flags as duplicates are
 // skipped) to the other surface (the nearest point of its nearest triangle, exactly).
 //
-// Nothing is gathered. Space is cut into cells; each vertex goes to its cell's rank, with the
-// other surface's triangles that come within a radius R of the cell (its halo). A vertex whose
+// Nothing is gathered. Space is cut into cells, their layers along z given to the ranks in
+// contiguous ranges balanced by the vertices to measure (so that the ranks' own parts, slabs
+// along z, mostly stay where they are); each vertex goes to its cell's rank, with the other
+// surface's triangles that come within a radius R of the cell (its halo). A vertex whose
 // nearest triangle is within R has its exact distance; the few farther ones are measured again
 // in a next round, R eight times larger, with the triangles sent again for their cells only,
 // until none is left (R beyond the surfaces' extent sends every triangle). A vertex's distance
@@ -260,14 +262,15 @@ struct DirectedDistance
   std::int64_t Count = 0;
 };
 
-/// The cells that own the vertices: a grid over the surfaces' global box, each cell's rank by a
-/// hash of its position (so a region's work spreads over the ranks).
+/// The cells that own the vertices: a grid over the surfaces' global box, its layers along z in
+/// contiguous ranges, one a rank (LayerRanks), so that the ranks' own parts, slabs along z as
+/// the volume's pieces are, stay mostly where they are.
 struct DistanceCells
 {
   double Origin[3] = { 0, 0, 0 };
   double Size = 1;
   std::int64_t Dims[3] = { 1, 1, 1 };
-  int Ranks = 1;
+  std::vector<int> LayerRank = { 0 }; // the rank of each layer along z
 
   std::int64_t CellOf(const double* p) const
   {
@@ -282,8 +285,38 @@ struct DistanceCells
   }
   int RankOf(std::int64_t cell) const
   {
-    const std::uint64_t h = static_cast<std::uint64_t>(cell) * 0x9E3779B97F4A7C15ull;
-    return static_cast<int>((h >> 32) % static_cast<std::uint64_t>(this->Ranks));
+    return this->LayerRank[static_cast<std::size_t>(cell / (this->Dims[0] * this->Dims[1]))];
+  }
+  /// Gives the layers to the ranks in contiguous ranges balanced by the `points` (3 values a
+  /// vertex) of all ranks in them: a layer goes to the rank whose share holds the layer's middle
+  /// vertex (collective).
+  bool BalanceLayers(Ranks& ranks, const double* points, std::size_t values, std::string& problem)
+  {
+    const std::size_t layers = static_cast<std::size_t>(this->Dims[2]);
+    std::vector<std::int64_t> mine(layers, 0), all(layers, 0);
+    for (std::size_t i = 0; i < values; i += 3)
+    {
+      ++mine[static_cast<std::size_t>(this->CellOf(points + i) / (this->Dims[0] * this->Dims[1]))];
+    }
+    ranks.AllReduce(mine.data(), all.data(), static_cast<vtkIdType>(layers),
+      vtkCommunicator::SUM_OP, "the vertices in each layer of cells");
+    std::int64_t total = 0;
+    for (std::int64_t n : all)
+    {
+      total += n;
+    }
+    this->LayerRank.assign(layers, 0);
+    std::int64_t before = 0;
+    for (std::size_t l = 0; l < layers; ++l)
+    {
+      const double middle = static_cast<double>(before) + 0.5 * static_cast<double>(all[l]);
+      this->LayerRank[l] = total == 0
+        ? 0
+        : std::min(
+            ranks.Size - 1, static_cast<int>(middle * ranks.Size / static_cast<double>(total)));
+      before += all[l];
+    }
+    return ranks.Agree(true, problem);
   }
   /// Calls f(cell) for every cell that a box grown by r overlaps.
   template <typename F>
@@ -314,14 +347,18 @@ struct DistanceCells
   }
 };
 
-/// Measures the vertices `points` (at their cell's rank already) against `triangles`, within
-/// `limit`: adds the resolved ones to `into`, returns the others' coordinates.
-template <typename Points, typename Triangles> // contiguous containers of doubles (or floats)
-std::vector<double> MeasureWithin(const Points& points, const Triangles& triangles, double bucket,
-  double limit, DirectedDistance& into)
+/// Measures the vertices `points` (at their cell's rank already) against `triangles` and
+/// `halo` (the rank's own triangles, in place, and those other ranks sent: a vertex's nearest
+/// is the nearer of the two sets' nearest), within `limit`: adds the resolved ones to `into`,
+/// returns the others' coordinates.
+// Contiguous containers of doubles (or floats).
+template <typename Points, typename Triangles, typename Halo>
+std::vector<double> MeasureWithin(const Points& points, const Triangles& triangles,
+  const Halo& halo, double bucket, double limit, DirectedDistance& into)
 {
   SpanMark("distance: buckets");
   const TriangleBuckets buckets(triangles, bucket, Tasks());
+  const TriangleBuckets haloBuckets(halo, bucket, Tasks());
   SpanMark("distance: nearest triangles");
   const vtkIdType n = static_cast<vtkIdType>(points.size() / 3);
   // The searches in the order of their home buckets (the results do not depend on the order:
@@ -337,7 +374,7 @@ std::vector<double> MeasureWithin(const Points& points, const Triangles& triangl
     [&](vtkIdType task, vtkIdType begin, vtkIdType end)
     {
       DirectedDistance& part = parts[task];
-      TriangleBucketsMemo memo;
+      TriangleBucketsMemo memo, haloMemo;
       constexpr vtkIdType ahead = 8; // searches between a point's prefetch and its search
       for (vtkIdType i = begin; i < end; ++i)
       {
@@ -347,7 +384,9 @@ std::vector<double> MeasureWithin(const Points& points, const Triangles& triangl
             points.data() + 3 * (order[static_cast<std::size_t>(i + ahead)] & indexMask));
         }
         const double* p = points.data() + 3 * (order[static_cast<std::size_t>(i)] & indexMask);
-        const double d2 = buckets.Nearest2(p, limit, memo);
+        const double d2 = halo.empty()
+          ? buckets.Nearest2(p, limit, memo)
+          : std::min(buckets.Nearest2(p, limit, memo), haloBuckets.Nearest2(p, limit, haloMemo));
         if (d2 > limit * limit)
         {
           far[task].insert(far[task].end(), p, p + 3);
@@ -400,7 +439,7 @@ inline bool ReduceDirected(Ranks& ranks, DirectedDistance& result, std::string& 
 /// The distances from `from`'s vertices to `to`'s triangles, over all ranks (collective).
 /// `floats`: every rank's `to` holds its triangles as floats (or none).
 inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const DistanceSurface& to,
-  bool floats, const DistanceCells& cells, double radius, double bucket, double extent,
+  bool floats, const DistanceCells& layout, double radius, double bucket, double extent,
   DirectedDistance& result, std::string& problem)
 {
   const int size = ranks.Size;
@@ -412,11 +451,17 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
         to.WithTriangles(
           [&](const auto& triangles)
           {
-            MeasureWithin(
-              from.Points, triangles, bucket, std::numeric_limits<double>::infinity(), result);
+            MeasureWithin(from.Points, triangles, std::vector<float>(), bucket,
+              std::numeric_limits<double>::infinity(), result);
           });
       });
     return ranks.Agree(problem.empty(), problem) && ReduceDirected(ranks, result, problem);
+  }
+  // The vertices' cells on their ranks, balanced for this direction's vertices.
+  DistanceCells cells = layout;
+  if (!cells.BalanceLayers(ranks, from.Points.data(), from.Points.size(), problem))
+  {
+    return false;
   }
   std::vector<bool> everyone(static_cast<std::size_t>(size), true);
   // Round 0: every vertex to its cell's rank; later rounds: the far ones stay where they are.
@@ -447,20 +492,23 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
     wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
     std::vector<std::vector<vtkIdType>> told(static_cast<std::size_t>(size), wanted);
     const auto cellsOf = ranks.Exchange(told, everyone, DistanceCellsTag);
-    const std::vector<std::vector<vtkIdType>> sorted(cellsOf.begin(), cellsOf.end());
+    // Whether another rank has vertices to measure in a cell: most triangles reach no such
+    // cell, and stay here, measured in place.
+    std::vector<bool> wantedElsewhere(
+      static_cast<std::size_t>(cells.Dims[0] * cells.Dims[1] * cells.Dims[2]), false);
+    for (int q = 0; q < size; ++q)
+    {
+      for (vtkIdType cell : q == ranks.Rank ? std::vector<vtkIdType>() : cellsOf[q])
+      {
+        wantedElsewhere[static_cast<std::size_t>(cell)] = true;
+      }
+    }
     // The triangles travel as floats where every rank's are floats (half the bytes, the same
     // values), as doubles otherwise: the ranks agree on the type (DecimationDistance).
     auto route = [&](const auto& corners, auto zero)
     {
       using Value = decltype(zero);
       std::vector<std::vector<Value>> triangles(static_cast<std::size_t>(size));
-      if (r == radius) // the first round sends about each rank's share, and a little more
-      {
-        for (auto& part : triangles)
-        {
-          part.reserve(corners.size() / static_cast<std::size_t>(size) * 5 / 4);
-        }
-      }
       std::vector<std::size_t> sentAt(static_cast<std::size_t>(size), corners.size());
       for (std::size_t t = 0; t < corners.size(); t += 9)
       {
@@ -471,21 +519,20 @@ inline bool MeasureDirected(Ranks& ranks, const DistanceSurface& from, const Dis
           [&](std::int64_t cell)
           {
             const int owner = cells.RankOf(cell);
-            if (sentAt[owner] != t &&
-              std::binary_search(sorted[owner].begin(), sorted[owner].end(), cell))
+            if (sentAt[owner] != t && wantedElsewhere[static_cast<std::size_t>(cell)])
             {
               sentAt[owner] = t;
               triangles[owner].insert(triangles[owner].end(), c, c + 9);
             }
           });
       }
-      const std::vector<Value> near =
+      const std::vector<Value> halo =
         Concatenate(ranks.Exchange(std::move(triangles), everyone, DistanceTrianglesTag));
       TryLocally(problem, "measure the distances",
         [&]()
         {
           mine = MeasureWithin(
-            mine, near, bucket, all ? std::numeric_limits<double>::infinity() : r, result);
+            mine, corners, halo, bucket, all ? std::numeric_limits<double>::infinity() : r, result);
         });
     };
     to.WithTriangles(
@@ -578,7 +625,6 @@ inline bool DecimationDistance(Ranks& ranks, vtkPolyData* input, vtkPolyData* ou
     return true;
   }
   DistanceCells cells;
-  cells.Ranks = ranks.Size;
   const double diagonal = extent * std::sqrt(3.0);
   auto radiusFor = [&](std::int64_t triangles)
   { return 2 * diagonal / std::sqrt(static_cast<double>(triangles)); };
