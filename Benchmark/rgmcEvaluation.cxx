@@ -30,6 +30,7 @@
 #include "rgmcDistributedData.h" // BlockPiece, ghost marking
 #include "vtkRGMarchingCubes.h"
 #include "vtkRGPhantomSource.h"
+#include "vtkRGPieces.h" // the phantom's pieces
 #include "vtkRGSeamRepair.h"
 
 #include "vtkAppendPolyData.h"
@@ -40,6 +41,8 @@
 #include "vtkFlyingEdges3D.h"
 #include "vtkHausdorffDistancePointSetFilter.h"
 #include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
 #include "vtkLogger.h"
 #include "vtkMPICommunicator.h"
 #include "vtkMPIController.h"
@@ -54,6 +57,7 @@
 #include "vtkRGCompatibility.h"
 #include "vtkSmartPointer.h"
 #include "vtkSmoothPolyDataFilter.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkWindowedSincPolyDataFilter.h"
 
 #include <unistd.h>
@@ -249,7 +253,18 @@ vtkSmartPointer<vtkImageData> PlainPiece(vtkImageData* ghosted, const Case& c, i
   }
   const int whole[6] = { 0, c.Dims[0] - 1, 0, c.Dims[1] - 1, 0, c.Dims[2] - 1 };
   int owned[6], ghostedExtent[6];
-  rgmc_test::BlockPiece(whole, rank, ranks, owned, ghostedExtent);
+  if (c.Field == "phantom")
+  {
+    // The phantom cuts its pieces itself, in slabs along z as the plugin's readers do.
+    vtkNew<vtkInformation> request;
+    request->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), rank);
+    request->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), ranks);
+    rgmc::SlabPiece(request, whole, ghostedExtent, owned);
+  }
+  else
+  {
+    rgmc_test::BlockPiece(whole, rank, ranks, owned, ghostedExtent);
+  }
   vtkNew<vtkExtractVOI> crop;
   crop->SetInputData(ghosted);
   crop->SetVOI(owned);
