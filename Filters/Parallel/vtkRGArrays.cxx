@@ -125,6 +125,23 @@ std::vector<Extremes<T>> ComponentExtremes(const T* values, vtkIdType tuples, in
   return result;
 }
 
+/// Stores the ranges (`all`) and finite ranges (`finite`), low and high for each of
+/// `components`, where VTK keeps them.
+void SetRanges(vtkDataArray* array, const double* all, const double* finite, int components)
+{
+  vtkNew<vtkInformationVector> allRanges, finiteRanges;
+  allRanges->SetNumberOfInformationObjects(components);
+  finiteRanges->SetNumberOfInformationObjects(components);
+  for (int k = 0; k < components; ++k)
+  {
+    allRanges->GetInformationObject(k)->Set(vtkDataArray::COMPONENT_RANGE(), all + 2 * k, 2);
+    finiteRanges->GetInformationObject(k)->Set(vtkDataArray::COMPONENT_RANGE(), finite + 2 * k, 2);
+  }
+  vtkInformation* info = array->GetInformation();
+  info->Set(vtkAbstractArray::PER_COMPONENT(), allRanges);
+  info->Set(vtkAbstractArray::PER_FINITE_COMPONENT(), finiteRanges);
+}
+
 template <typename T>
 void StoreRanges(vtkDataArray* array, const T* values)
 {
@@ -137,19 +154,13 @@ void StoreRanges(vtkDataArray* array, const T* values)
       return; // VTK's own scan decides what such a component's range is
     }
   }
-  vtkNew<vtkInformationVector> all, finite;
-  all->SetNumberOfInformationObjects(components);
-  finite->SetNumberOfInformationObjects(components);
-  for (int k = 0; k < components; ++k)
+  std::vector<double> all, finite; // low, high a component
+  for (const auto& e : extremes)
   {
-    const double a[2] = { double(extremes[k].AllLow), double(extremes[k].AllHigh) };
-    const double f[2] = { double(extremes[k].FiniteLow), double(extremes[k].FiniteHigh) };
-    all->GetInformationObject(k)->Set(vtkDataArray::COMPONENT_RANGE(), a, 2);
-    finite->GetInformationObject(k)->Set(vtkDataArray::COMPONENT_RANGE(), f, 2);
+    all.insert(all.end(), { double(e.AllLow), double(e.AllHigh) });
+    finite.insert(finite.end(), { double(e.FiniteLow), double(e.FiniteHigh) });
   }
-  vtkInformation* info = array->GetInformation();
-  info->Set(vtkAbstractArray::PER_COMPONENT(), all);
-  info->Set(vtkAbstractArray::PER_FINITE_COMPONENT(), finite);
+  SetRanges(array, all.data(), finite.data(), components);
 }
 
 } // namespace
@@ -177,14 +188,7 @@ void CacheRanges(vtkDataArray* array)
 
 void StoreRange(vtkDataArray* array, const double range[2])
 {
-  vtkNew<vtkInformationVector> all, finite;
-  all->SetNumberOfInformationObjects(1);
-  finite->SetNumberOfInformationObjects(1);
-  all->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), range, 2);
-  finite->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), range, 2);
-  vtkInformation* info = array->GetInformation();
-  info->Set(vtkAbstractArray::PER_COMPONENT(), all);
-  info->Set(vtkAbstractArray::PER_FINITE_COMPONENT(), finite);
+  SetRanges(array, range, range, 1);
 }
 
 } // namespace rgmc
