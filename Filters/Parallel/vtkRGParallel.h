@@ -122,9 +122,34 @@ std::vector<std::size_t> CountBefore(vtkIdType n, vtkIdType chunk, Counted&& cou
   return CountBefore(n, chunk, counted, Tasks());
 }
 
+/// How many of the first `d` elements std::merge takes from the sorted range `first` (of
+/// `firstCount`) when merging it with the sorted range `second` (of `secondCount`): equal
+/// elements come from `first` first. A merge path: a binary search over the d + 1 ways to split.
+template <typename Iterator>
+std::size_t MergedFromFirst(
+  Iterator first, std::size_t firstCount, Iterator second, std::size_t secondCount, std::size_t d)
+{
+  std::size_t low = d > secondCount ? d - secondCount : 0, high = std::min(d, firstCount);
+  while (low < high)
+  {
+    const std::size_t i = low + (high - low) / 2;
+    // first[i] goes before second[d - i - 1] (ties to `first`): more than i from `first`.
+    if (!(*(second + (d - i - 1)) < *(first + i)))
+    {
+      low = i + 1;
+    }
+    else
+    {
+      high = i;
+    }
+  }
+  return low;
+}
+
 /// Sorts [begin, end) on threads: fixed slices (not one per thread) sorted at once, then merged
-/// pairwise in rounds. The elements must be totally ordered (no two equal), so that the result
-/// is the one std::sort gives, whatever the threads. Needs a buffer of the range's size.
+/// pairwise in rounds, each merge in pieces of a slice (MergedFromFirst). The elements must be
+/// totally ordered (no two equal), so that the result is the one std::sort gives, whatever the
+/// threads. Needs a buffer of the range's size.
 template <typename Vector>
 void ParallelSort(Vector& values)
 {
@@ -151,16 +176,27 @@ void ParallelSort(Vector& values)
   Vector* to = &buffer;
   for (std::size_t run = slice; run < n; run *= 2)
   {
+    // Each pair of runs merged in pieces of `slice` outputs (merge paths), so that every round
+    // has as many tasks as the first, not half as many as the round before.
+    const std::size_t pieces = 2 * run / slice;
     const vtkIdType pairs = static_cast<vtkIdType>((n + 2 * run - 1) / (2 * run));
-    ParallelFor(pairs, 1,
+    ParallelFor(pairs * static_cast<vtkIdType>(pieces), 1,
       [&](vtkIdType first, vtkIdType last)
       {
-        for (vtkIdType p = first; p < last; ++p)
+        for (vtkIdType t = first; t < last; ++t)
         {
-          const std::size_t a = static_cast<std::size_t>(p) * 2 * run;
+          const std::size_t a = static_cast<std::size_t>(t) / pieces * 2 * run;
+          const std::size_t q = static_cast<std::size_t>(t) % pieces;
           const std::size_t b = std::min(n, a + run), c = std::min(n, a + 2 * run);
-          std::merge(from->begin() + a, from->begin() + b, from->begin() + b, from->begin() + c,
-            to->begin() + a);
+          const std::size_t d0 = std::min(c - a, q * slice), d1 = std::min(c - a, (q + 1) * slice);
+          if (d0 < d1)
+          {
+            const auto in = from->begin();
+            const std::size_t i0 = MergedFromFirst(in + a, b - a, in + b, c - b, d0);
+            const std::size_t i1 = MergedFromFirst(in + a, b - a, in + b, c - b, d1);
+            std::merge(in + a + i0, in + a + i1, in + b + (d0 - i0), in + b + (d1 - i1),
+              to->begin() + a + d0);
+          }
         }
       });
     std::swap(from, to);

@@ -1,6 +1,7 @@
 // The work/span profile's recorder (see vtkRGSpan.h).
 #include "vtkRGSpan.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -105,6 +106,95 @@ SpanPhase SpanRecorder::Total(const std::string& name) const
     total.Tasks += phase.Tasks;
   }
   return total;
+}
+
+namespace
+{
+
+double WorkOf(const std::vector<SpanPhase>& phases)
+{
+  double work = 0;
+  for (const SpanPhase& phase : phases)
+  {
+    work += phase.Work;
+  }
+  return work;
+}
+
+bool SameSteps(const std::vector<SpanPhase>& a, const std::vector<SpanPhase>& b)
+{
+  if (a.size() != b.size())
+  {
+    return false;
+  }
+  for (std::size_t p = 0; p < a.size(); ++p)
+  {
+    if (a[p].Name != b[p].Name || a[p].TaskTimes.size() != b[p].TaskTimes.size())
+    {
+      return false;
+    }
+    for (std::size_t s = 0; s < a[p].TaskTimes.size(); ++s)
+    {
+      if (a[p].TaskTimes[s].size() != b[p].TaskTimes[s].size())
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+} // namespace
+
+bool LeastOver(const std::vector<std::vector<SpanPhase>>& runs, std::vector<SpanPhase>& least)
+{
+  least.clear();
+  if (runs.empty())
+  {
+    return true;
+  }
+  for (const std::vector<SpanPhase>& run : runs)
+  {
+    if (!SameSteps(run, runs[0]))
+    {
+      least = *std::min_element(runs.begin(), runs.end(),
+        [](const std::vector<SpanPhase>& a, const std::vector<SpanPhase>& b)
+        { return WorkOf(a) < WorkOf(b); });
+      return false;
+    }
+  }
+  least = runs[0];
+  for (std::size_t p = 0; p < least.size(); ++p)
+  {
+    SpanPhase& phase = least[p];
+    double serial = phase.Work - phase.ParallelWork;
+    for (const std::vector<SpanPhase>& run : runs)
+    {
+      const SpanPhase& other = run[p];
+      serial = std::min(serial, other.Work - other.ParallelWork);
+      for (std::size_t s = 0; s < phase.TaskTimes.size(); ++s)
+      {
+        for (std::size_t t = 0; t < phase.TaskTimes[s].size(); ++t)
+        {
+          phase.TaskTimes[s][t] = std::min(phase.TaskTimes[s][t], other.TaskTimes[s][t]);
+        }
+      }
+    }
+    phase.ParallelWork = 0;
+    phase.LongestTasks = 0;
+    for (const std::vector<double>& step : phase.TaskTimes)
+    {
+      double longest = 0;
+      for (double took : step)
+      {
+        phase.ParallelWork += took;
+        longest = std::max(longest, took);
+      }
+      phase.LongestTasks += longest;
+    }
+    phase.Work = serial + phase.ParallelWork;
+  }
+  return true;
 }
 
 } // namespace rgmc

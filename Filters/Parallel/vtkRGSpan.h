@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rgmc
@@ -30,6 +31,7 @@ struct SpanPhase
   double LongestTasks = 0; // the sum over parallel steps of each step's longest task
   long long Steps = 0;     // parallel steps (ParallelFor calls)
   long long Tasks = 0;     // tasks in those steps
+  std::vector<std::vector<double>> TaskTimes; // each step's tasks, in order
 
   /// The serial sections plus each parallel step's longest task.
   double Span() const { return this->Work - this->ParallelWork + this->LongestTasks; }
@@ -71,6 +73,8 @@ public:
     grain = std::max<vtkIdType>(1, grain);
     double total = 0, longest = 0;
     long long tasks = 0;
+    std::vector<double> times;
+    times.reserve(static_cast<std::size_t>((count + grain - 1) / grain));
     struct InTask
     {
       bool& Flag;
@@ -88,6 +92,7 @@ public:
       const double took = this->Clock() - start;
       total += took;
       longest = std::max(longest, took);
+      times.push_back(took);
       ++tasks;
     }
     SpanPhase& phase = this->Recorded[this->Current];
@@ -95,6 +100,7 @@ public:
     phase.LongestTasks += longest;
     phase.Steps += 1;
     phase.Tasks += tasks;
+    phase.TaskTimes.push_back(std::move(times));
   }
 
   /// The recorder recording now, outside any task; null otherwise (a filter's normal run).
@@ -110,6 +116,14 @@ private:
   bool Running = false; // inside a task: nested parallel loops are part of it
   bool Started = false;
 };
+
+/// The phases of several recorded runs of one stage, each serial section (a phase's time outside
+/// its steps) and each task at its least time over the runs: the run without the machine's
+/// interruptions, which land in one run's task and not in another's. A single interruption of a
+/// task would otherwise count whole in its step's longest task. The runs must have taken the
+/// same steps with the same tasks (a deterministic stage); false, with `least` the run of least
+/// work, when they did not.
+bool LeastOver(const std::vector<std::vector<SpanPhase>>& runs, std::vector<SpanPhase>& least);
 
 /// Names the phase that starts here, when a recorder records; nothing otherwise.
 inline void SpanMark(const char* name)

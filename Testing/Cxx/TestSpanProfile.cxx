@@ -4,7 +4,9 @@
 // or with no recorder, does nothing; the prefix of a filter inside another; an exception leaves
 // the recorder usable; ParallelSort takes its parallel path while recording, with std::sort's
 // result; outside a recording, the loops run on vtkSMPTools as before; the chunked passes
-// (ForEachChunk, CountBefore, PlaceChunks) give the serial results on any number of threads.
+// (ForEachChunk, CountBefore, PlaceChunks) give the serial results on any number of threads;
+// runs combined task by task at their least times (LeastOver), and not when their steps differ;
+// ParallelSort's merges in pieces (merge paths) with std::merge's result and order of ties.
 #include "rgmcCheck.h"
 #include "rgmcTaskOrders.h"
 #include "vtkRGParallel.h"
@@ -379,6 +381,139 @@ void TestForEachChunk()
 
 } // namespace
 
+/// One run of a stage on the test's clock: a serial section of `serial`, then a step of tasks
+/// costing `tasks` (in order), then a second phase with one serial section of 1 and, when
+/// `second` is positive, a step of `second` tasks of cost 1.
+std::vector<rgmc::SpanPhase> Run(double serial, const std::vector<double>& tasks, int second = 0)
+{
+  double now = 0;
+  rgmc::SpanRecorder recorder([&now]() { return now; });
+  recorder.Start("first");
+  now += serial;
+  rgmc::ParallelFor(static_cast<vtkIdType>(tasks.size()), 1,
+    [&](vtkIdType begin, vtkIdType) { now += tasks[static_cast<std::size_t>(begin)]; });
+  rgmc::SpanMark("second");
+  now += 1;
+  if (second > 0)
+  {
+    rgmc::ParallelFor(second, 1, [&](vtkIdType, vtkIdType) { now += 1; });
+  }
+  recorder.Stop();
+  return recorder.Phases();
+}
+
+void TestLeastOver()
+{
+  // Each run interrupted once (a task's time doubled, a serial section lengthened): the least
+  // over the runs is the uninterrupted run, though no run was.
+  const std::vector<std::vector<rgmc::SpanPhase>> runs = { Run(2, { 3, 8, 2 }), Run(5, { 6, 4, 2 }),
+    Run(2, { 3, 4, 4 }) };
+  std::vector<rgmc::SpanPhase> least;
+  RGMC_CHECK(rgmc::LeastOver(runs, least), "the same steps in every run");
+  RGMC_CHECK(least.size() == 2 && least[0].Name == "first" && least[1].Name == "second",
+    "the phases, in order");
+  const rgmc::SpanPhase& first = least[0];
+  RGMC_CHECK(first.TaskTimes.size() == 1 && first.TaskTimes[0] == std::vector<double>({ 3, 4, 2 }),
+    "each task at its least time");
+  RGMC_CHECK(Near(first.Work, 2 + 9) && Near(first.ParallelWork, 9) &&
+      Near(first.LongestTasks, 4) && Near(first.Span(), 6),
+    "work 11, span 6 from the least serial section and tasks");
+  for (const std::vector<rgmc::SpanPhase>& run : runs)
+  {
+    RGMC_CHECK(run[0].Work > first.Work + 1, "every run took longer");
+  }
+  RGMC_CHECK(Near(least[1].Work, 1) && Near(least[1].Span(), 1), "a serial phase");
+  RGMC_CHECK(first.Steps == 1 && first.Tasks == 3, "steps and tasks kept");
+
+  // Runs that took different steps are not combined: the run of least work is returned.
+  const std::vector<std::vector<rgmc::SpanPhase>> differing = { Run(2, { 3, 8, 2 }),
+    Run(2, { 1, 1 }), Run(2, { 3, 4, 4 }, 2) };
+  RGMC_CHECK(!rgmc::LeastOver(differing, least), "different tasks are found");
+  RGMC_CHECK(least.size() == 2 && Near(least[0].Work, 4) && Near(least[0].Span(), 3),
+    "the run of least work");
+  RGMC_CHECK(rgmc::LeastOver({}, least) && least.empty(), "no runs, no phases");
+}
+
+/// A key with a tag that the order ignores: equal keys tell which range an element came from.
+struct Tagged
+{
+  int Key;
+  int Tag;
+  bool operator<(const Tagged& other) const { return this->Key < other.Key; }
+  bool operator==(const Tagged& other) const
+  {
+    return this->Key == other.Key && this->Tag == other.Tag;
+  }
+};
+
+/// ParallelSort's merges in pieces: split at any output position by MergedFromFirst, the two
+/// pieces' merges are the whole merge, ties taken from the first range first (std::merge's
+/// rule); ParallelSort on 1, 2, 16 and 64 threads and while recording gives std::sort's order
+/// for sizes whose last runs are short, and every merge round has as many tasks as the first.
+void TestMergePaths()
+{
+  std::mt19937 random(11);
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    std::vector<Tagged> first(random() % 12), second(random() % 12);
+    for (std::size_t i = 0; i < first.size(); ++i)
+    {
+      first[i] = Tagged{ static_cast<int>(random() % 6), static_cast<int>(i) };
+    }
+    for (std::size_t i = 0; i < second.size(); ++i)
+    {
+      second[i] = Tagged{ static_cast<int>(random() % 6), 100 + static_cast<int>(i) };
+    }
+    std::stable_sort(first.begin(), first.end());
+    std::stable_sort(second.begin(), second.end());
+    std::vector<Tagged> whole(first.size() + second.size());
+    std::merge(first.begin(), first.end(), second.begin(), second.end(), whole.begin());
+    for (std::size_t d = 0; d <= whole.size(); ++d)
+    {
+      const std::size_t i =
+        rgmc::MergedFromFirst(first.begin(), first.size(), second.begin(), second.size(), d);
+      std::vector<Tagged> pieces(whole.size());
+      std::merge(
+        first.begin(), first.begin() + i, second.begin(), second.begin() + (d - i), pieces.begin());
+      std::merge(
+        first.begin() + i, first.end(), second.begin() + (d - i), second.end(), pieces.begin() + d);
+      RGMC_CHECK(pieces == whole, "two pieces merged are the whole merge, ties first-first");
+    }
+  }
+  for (std::size_t n : { std::size_t(4096 * 5 + 17), std::size_t(4096 * 64 + 4095) })
+  {
+    std::vector<std::uint64_t> values(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      values[i] = (random() * 1000003ULL << 20) | i;
+    }
+    std::vector<std::uint64_t> expected = values;
+    std::sort(expected.begin(), expected.end());
+    for (int threads : { 1, 2, 16, 64 })
+    {
+      vtkSMPTools::LocalScope(vtkSMPTools::Config{ threads, "STDThread", false },
+        [&]()
+        {
+          std::vector<std::uint64_t> sorted = values;
+          rgmc::ParallelSort(sorted);
+          RGMC_CHECK(sorted == expected, "ParallelSort on threads: std::sort's order");
+        });
+    }
+    rgmc::SpanRecorder recorder;
+    recorder.Start("sort");
+    std::vector<std::uint64_t> sorted = values;
+    rgmc::ParallelSort(sorted);
+    recorder.Stop();
+    RGMC_CHECK(sorted == expected, "ParallelSort while recording: std::sort's order");
+    const std::vector<std::vector<double>>& steps = recorder.Phases()[0].TaskTimes;
+    RGMC_CHECK(steps.size() > 1, "slices and merge rounds");
+    for (std::size_t r = 1; r < steps.size(); ++r)
+    {
+      RGMC_CHECK(steps[r].size() >= steps[0].size(), "every merge round as many tasks as slices");
+    }
+  }
+}
+
 int main()
 {
   TestAccounting();
@@ -387,5 +522,7 @@ int main()
   TestCountBefore();
   TestPlaceChunks();
   TestForEachChunk();
+  TestLeastOver();
+  TestMergePaths();
   return rgmc_test::Result("TestSpanProfile");
 }
