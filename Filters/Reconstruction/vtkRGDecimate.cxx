@@ -207,6 +207,7 @@ int vtkRGDecimate::RequestData(
       return fail();
     }
     run.Passes = pass + 1;
+    rgmc::SpanMark("release memory");
     // The pass's blocks and messages are freed; give their pages back, so that the next pass's
     // do not come on top of them (glibc keeps freed memory, the threads' arenas most of all).
     ReleaseFreeMemory();
@@ -381,6 +382,7 @@ bool vtkRGDecimate::PlaceBlocks(Run& run, int pass)
   }
   run.Ranks.AllReduce(mine.data(), run.BlockTriangles.data(), static_cast<vtkIdType>(mine.size()),
     vtkCommunicator::SUM_OP, "counting the blocks' triangles");
+  rgmc::SpanMark("place blocks: assign");
   this->AssignBlocks(run);
   return run.Ranks.Agree(run.Problem.empty(), run.Problem);
 }
@@ -474,6 +476,7 @@ void vtkRGDecimate::AssignBlocks(Run& run)
 // blocks of each vertex in more than one.
 bool vtkRGDecimate::FindSharedVertices(Run& run)
 {
+  rgmc::SpanMark("place blocks: shared vertices");
   const int size = run.Ranks.Size;
   Messages outgoing(static_cast<std::size_t>(size));
   if (!run.Ranks.Step(
@@ -643,7 +646,7 @@ bool vtkRGDecimate::SimplifyBlocks(Run& run, int wave)
 // error so far in their block), ties by block and order.
 bool vtkRGDecimate::KeepCheapest(Run& run, bool all)
 {
-  rgmc::SpanMark("keep cheapest, apply collapses");
+  rgmc::SpanMark("keep cheapest");
   // Collapses found, and the blocks' vertices, fixed or not.
   vtkIdType local[3] = { 0, 0, 0 }, sums[3] = { 0, 0, 0 };
   for (const Block& block : run.Blocks)
@@ -740,6 +743,7 @@ void vtkRGDecimate::KeepUpToThreshold(Run& run, double threshold, vtkIdType need
 // collapses) and simplified as far as they keep.
 bool vtkRGDecimate::ApplyCollapses(Run& run)
 {
+  rgmc::SpanMark("apply collapses");
   Ranks& ranks = run.Ranks;
   CollapsedBlocks collapsed;
   // Sized once from the counts (each collapse removes two of a block's own triangles), so that
@@ -776,6 +780,7 @@ bool vtkRGDecimate::ApplyCollapses(Run& run)
       ReleaseFreeMemory();
     }
   }
+  rgmc::SpanMark("apply collapses: free blocks");
   if (!ranks.Step("make the blocks the part", run.Problem,
         [&]()
         {
@@ -783,6 +788,7 @@ bool vtkRGDecimate::ApplyCollapses(Run& run)
           std::vector<std::int32_t>().swap(run.PartBlock);
           std::vector<std::uint32_t>().swap(run.SharedFirst);
           std::vector<std::int32_t>().swap(run.SharedBlocks);
+          rgmc::SpanMark("apply collapses: adopt");
           run.Part.Adopt(collapsed.Surface, collapsed.Vertices);
         }))
   {
