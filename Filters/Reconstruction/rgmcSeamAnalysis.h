@@ -165,8 +165,8 @@ private:
     // smoothing's peak is no higher than with 64-bit stencils and no corner lists.
     if (!stencils || sizeof(I) > 4)
     {
-      rgmc::LargeVector<I>().swap(this->Corners);
-      std::vector<vtkIdType>().swap(this->CornerOffsets);
+      rgmc::OverwriteVector<I>().swap(this->Corners);
+      rgmc::OverwriteVector<vtkIdType>().swap(this->CornerOffsets);
     }
   }
 

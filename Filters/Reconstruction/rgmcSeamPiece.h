@@ -156,7 +156,8 @@ struct SeamPiece
   /// The triangle corners (3 t + k, of type I as the connectivity's entries are) at each vertex,
   /// in compressed rows, each in increasing order: on threads where the vertices follow the
   /// triangles (rgmc::GroupByKey), else in one pass.
-  void CornersAround(std::vector<vtkIdType>& offsets, rgmc::LargeVector<I>& corners) const
+  void CornersAround(
+    rgmc::OverwriteVector<vtkIdType>& offsets, rgmc::OverwriteVector<I>& corners) const
   {
     if (!rgmc::SingleThreaded() &&
       rgmc::GroupByKey(
@@ -239,8 +240,8 @@ struct SeamPiece
 
   // The triangle corners at each vertex: made for the seams' analysis, kept for the normals
   // when the surface is smoothed and I is 32-bit (else made again).
-  std::vector<vtkIdType> CornerOffsets;
-  rgmc::LargeVector<I> Corners;
+  rgmc::OverwriteVector<vtkIdType> CornerOffsets; // written whole by CornersAround
+  rgmc::OverwriteVector<I> Corners;
 };
 
 } // namespace seam

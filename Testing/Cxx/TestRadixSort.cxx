@@ -137,6 +137,19 @@ void CheckGroups(const std::vector<int>& keyOf, std::int64_t keys, const char* w
         what << ", mode " << mode << ": refused, yet the outputs changed");
     }
   }
+  // Outputs that leave their values unset (as Seam Repair's corners are), here holding stale
+  // values of the right sizes: every value is written.
+  if (local)
+  {
+    rgmc::OverwriteVector<std::int64_t> gotOffsets(offsets.size(), 77);
+    rgmc::OverwriteVector<std::int32_t> gotItems(items.size(), -5);
+    rgmc::GroupByKey(
+      n, keys, [&keyOf](std::int64_t i) { return keyOf[static_cast<std::size_t>(i)]; }, gotOffsets,
+      gotItems, rgmc_test::TasksOnThreads);
+    RGMC_CHECK(std::equal(gotOffsets.begin(), gotOffsets.end(), offsets.begin(), offsets.end()) &&
+        std::equal(gotItems.begin(), gotItems.end(), items.begin(), items.end()),
+      what << ": unset outputs with stale values, every value written");
+  }
 }
 
 /// RadixDigits::For(any, every) against the expected digits: their width and lowest bits.

@@ -464,8 +464,11 @@ void TestMergePaths()
     {
       second[i] = Tagged{ static_cast<int>(random() % 6), 100 + static_cast<int>(i) };
     }
-    std::stable_sort(first.begin(), first.end());
-    std::stable_sort(second.begin(), second.end());
+    // Sorted by key, equal keys in the order of their tags (as a stable sort by key leaves them).
+    auto byKeyThenTag = [](const Tagged& a, const Tagged& b)
+    { return a.Key < b.Key || (a.Key == b.Key && a.Tag < b.Tag); };
+    std::sort(first.begin(), first.end(), byKeyThenTag);
+    std::sort(second.begin(), second.end(), byKeyThenTag);
     std::vector<Tagged> whole(first.size() + second.size());
     std::merge(first.begin(), first.end(), second.begin(), second.end(), whole.begin());
     for (std::size_t d = 0; d <= whole.size(); ++d)

@@ -152,12 +152,17 @@ bool GroupByKey(std::int64_t n, std::int64_t keys, KeyAt&& keyAt, Offsets& offse
     });
   // Per block of keys: each chunk's count becomes its first place among the key's indices, and
   // offsets[k + 1] the key's size; then the sizes summed, blocks first.
-  offsets.assign(static_cast<std::size_t>(keys) + 1, 0);
+  // Offsets and items that leave their values unset (OverwriteVector) are first written, and
+  // their pages faulted in, by the tasks below, not zeroed here on one thread.
+  offsets.resize(static_cast<std::size_t>(keys) + 1);
+  offsets[0] = 0;
   std::vector<std::int64_t> blockSize(static_cast<std::size_t>(blocks) + 1, 0);
   parallel(blocks,
     [&](std::int64_t b)
     {
       const std::int64_t first = b * keyBlock, last = std::min(keys, first + keyBlock);
+      std::fill(offsets.begin() + (first + 1), offsets.begin() + (last + 1),
+        typename Offsets::value_type(0));
       for (std::int64_t c = 0; c < chunks; ++c)
       {
         std::int64_t* count = counts.data() + base[c] - low[c];
