@@ -136,13 +136,7 @@ std::vector<rgmc::SpanPhase> Profile(Algorithm* algorithm, int repeats, rgmc::Sp
     });
   std::vector<rgmc::SpanPhase> least;
   matched = rgmc::LeastOver(runs, least);
-  total = rgmc::SpanPhase{ "total" };
-  for (const rgmc::SpanPhase& phase : least)
-  {
-    total.Work += phase.Work;
-    total.ParallelWork += phase.ParallelWork;
-    total.LongestTasks += phase.LongestTasks;
-  }
+  total = rgmc::TotalOf(least, "total");
   return least;
 }
 

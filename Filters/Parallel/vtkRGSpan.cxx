@@ -94,10 +94,10 @@ void SpanRecorder::Stop()
   }
 }
 
-SpanPhase SpanRecorder::Total(const std::string& name) const
+SpanPhase TotalOf(const std::vector<SpanPhase>& phases, const std::string& name)
 {
   SpanPhase total{ name };
-  for (const SpanPhase& phase : this->Recorded)
+  for (const SpanPhase& phase : phases)
   {
     total.Work += phase.Work;
     total.ParallelWork += phase.ParallelWork;
@@ -108,18 +108,13 @@ SpanPhase SpanRecorder::Total(const std::string& name) const
   return total;
 }
 
+SpanPhase SpanRecorder::Total(const std::string& name) const
+{
+  return TotalOf(this->Recorded, name);
+}
+
 namespace
 {
-
-double WorkOf(const std::vector<SpanPhase>& phases)
-{
-  double work = 0;
-  for (const SpanPhase& phase : phases)
-  {
-    work += phase.Work;
-  }
-  return work;
-}
 
 bool SameSteps(const std::vector<SpanPhase>& a, const std::vector<SpanPhase>& b)
 {
@@ -159,7 +154,7 @@ bool LeastOver(const std::vector<std::vector<SpanPhase>>& runs, std::vector<Span
     {
       least = *std::min_element(runs.begin(), runs.end(),
         [](const std::vector<SpanPhase>& a, const std::vector<SpanPhase>& b)
-        { return WorkOf(a) < WorkOf(b); });
+        { return TotalOf(a, "").Work < TotalOf(b, "").Work; });
       return false;
     }
   }

@@ -42,6 +42,9 @@ struct SpanPhase
   }
 };
 
+/// The phases as one phase: their sums (steps and tasks counted, task times not kept).
+SpanPhase TotalOf(const std::vector<SpanPhase>& phases, const std::string& name);
+
 /// Records one stage's phases. Start makes it the one recorder, Stop ends the last phase.
 class SpanRecorder
 {

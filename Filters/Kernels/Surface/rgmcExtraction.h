@@ -12,6 +12,7 @@
 #include "rgmcSampledVolume.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -230,7 +231,9 @@ private:
   static constexpr std::int64_t TotalsRange = 65536; // component totals: triangles per task
   static constexpr int MinChunkSlabs = 4; // slabs of cubes per chunk, on average (not per thread)
   static constexpr int MaxChunkSlabs = 16;
-  static constexpr int PrefetchAhead = 16; // nodes between a prefetch and the node's use
+  static constexpr int PrefetchAhead = 16;            // nodes between a prefetch and the node's use
+  static constexpr std::int64_t PieceVertices = 8192; // copy chunks: at most vertices a piece
+  static constexpr std::int64_t PieceTriangles = 16384; // and triangles a piece
 
   /// Vertex ids + 1 (0: none yet) of one plane of edges, with the entries written so far (to
   /// reset cheaply).
@@ -269,6 +272,13 @@ private:
     int LowK = 0, TopK = 0;
     /// Per vertex: its id in the joined mesh.
     std::vector<std::int32_t> FinalId;
+  };
+
+  /// A task of CopyChunks: a chunk's vertices [V0, V1) and triangles [T0, T1).
+  struct CopyPiece
+  {
+    int Chunk;
+    std::int64_t V0, V1, T0, T1;
   };
 
   /// The state of one chunk's extraction (one task). Its edge layers are plane-sized: they are
@@ -643,18 +653,17 @@ private:
     }
   }
 
-  /// The joined mesh: each chunk's own vertices and all its triangles, copied in place (the
-  /// chunks are released).
+  /// The joined mesh: each chunk's own vertices and all its triangles, copied in place, in
+  /// pieces of a chunk (many more tasks than chunks: a chunk is several milliseconds of
+  /// copying). Every piece writes its own places, so the mesh does not depend on the order; the
+  /// last piece of a chunk to end releases the chunk.
   void CopyChunks(std::vector<Chunk>& chunks, const std::vector<std::int64_t>& vertexBase,
     const std::vector<std::int64_t>& triangleBase, std::int64_t vertices, std::int64_t triangles)
   {
-    const std::int64_t numChunks = static_cast<std::int64_t>(chunks.size());
     LocalMesh& m = this->Mesh;
-    const bool doublePoints = this->Volume.Options.DoublePoints;
-    const bool normals = this->Volume.Options.ComputeNormals;
     const std::size_t nv = static_cast<std::size_t>(vertices);
     const std::size_t nt = static_cast<std::size_t>(triangles);
-    if (doublePoints)
+    if (this->Volume.Options.DoublePoints)
     {
       m.PointsDouble.resize_for_overwrite(3 * nv);
     }
@@ -662,7 +671,7 @@ private:
     {
       m.Points.resize_for_overwrite(3 * nv);
     }
-    if (normals)
+    if (this->Volume.Options.ComputeNormals)
     {
       m.Normals.resize_for_overwrite(3 * nv);
     }
@@ -670,51 +679,31 @@ private:
     m.VertexComponent.resize_for_overwrite(nv);
     m.Triangles.resize_for_overwrite(3 * nt);
     m.TriangleComponent.resize_for_overwrite(nt);
-    this->Volume.Parallel(numChunks,
-      [&](std::int64_t c)
+    std::vector<CopyPiece> pieces;
+    std::vector<std::atomic<int>> left(chunks.size());
+    for (std::size_t c = 0; c < chunks.size(); ++c)
+    {
+      const std::int64_t cv = chunks[c].Mesh.NumberOfPoints();
+      const std::int64_t ct = chunks[c].Mesh.NumberOfTriangles();
+      const std::int64_t k = std::max<std::int64_t>(1,
+        std::max(
+          (cv + PieceVertices - 1) / PieceVertices, (ct + PieceTriangles - 1) / PieceTriangles));
+      left[c].store(static_cast<int>(k), std::memory_order_relaxed);
+      for (std::int64_t i = 0; i < k; ++i)
       {
-        Chunk& chunk = chunks[c];
+        pieces.push_back(CopyPiece{
+          static_cast<int>(c), cv * i / k, cv * (i + 1) / k, ct * i / k, ct * (i + 1) / k });
+      }
+    }
+    this->Volume.Parallel(static_cast<std::int64_t>(pieces.size()),
+      [&](std::int64_t p)
+      {
+        const CopyPiece& piece = pieces[p];
+        Chunk& chunk = chunks[piece.Chunk];
+        this->CopyVertices(chunk, vertexBase[piece.Chunk], piece.V0, piece.V1);
+        const std::int64_t t0 = triangleBase[piece.Chunk];
         const LocalMesh& from = chunk.Mesh;
-        const std::int64_t base = vertexBase[c];
-        const std::int64_t nv = from.NumberOfPoints();
-        // The chunk's own vertices in batches: each batch's keys decoded (and its samples
-        // prefetched) while the batch before is placed.
-        constexpr int B = SampledVolume<Values>::VertexBatch;
-        struct Batch
-        {
-          int Points[B][3];
-          int Axis[B];
-          std::int64_t To[B];
-          int Count = 0;
-        } batches[2];
-        std::int64_t next = 0;
-        auto fill = [&](Batch& b)
-        {
-          b.Count = 0;
-          for (; next < nv && b.Count < B; ++next)
-          {
-            const std::int64_t to = chunk.FinalId[next];
-            if (to < base)
-            {
-              continue; // the chunk below's vertex
-            }
-            this->Volume.GridOf.Decode(from.Keys[next], b.Points[b.Count], b.Axis[b.Count]);
-            this->Volume.PrefetchAround(
-              b.Points[b.Count][0], b.Points[b.Count][1], b.Points[b.Count][2]);
-            b.To[b.Count++] = to;
-            m.Keys[to] = from.Keys[next];
-            m.VertexComponent[to] = from.VertexComponent[next];
-          }
-        };
-        fill(batches[0]);
-        for (int current = 0; batches[current].Count > 0; current = 1 - current)
-        {
-          fill(batches[1 - current]);
-          this->PlaceVertices(batches[current].Points, batches[current].Axis, batches[current].To,
-            batches[current].Count, doublePoints, normals);
-        }
-        const std::int64_t t0 = triangleBase[c];
-        for (std::int64_t t = 0; t < from.NumberOfTriangles(); ++t)
+        for (std::int64_t t = piece.T0; t < piece.T1; ++t)
         {
           for (int v = 0; v < 3; ++v)
           {
@@ -722,11 +711,57 @@ private:
           }
           m.TriangleComponent[t0 + t] = from.TriangleComponent[t];
         }
-        // The chunk's memory back as the joined mesh's fills, not after the last chunk.
-        chunk.Mesh.FreeNow();
-        DiscardPages(chunk.FinalId.data(), chunk.FinalId.size() * sizeof(std::int32_t));
-        chunk = Chunk();
+        // The chunk's memory back as the joined mesh fills, not after the last chunk.
+        if (left[piece.Chunk].fetch_sub(1, std::memory_order_acq_rel) == 1)
+        {
+          chunk.Mesh.FreeNow();
+          DiscardPages(chunk.FinalId.data(), chunk.FinalId.size() * sizeof(std::int32_t));
+          chunk = Chunk();
+        }
       });
+  }
+
+  /// A chunk's own vertices among its vertices [v0, v1), placed in the joined mesh in batches:
+  /// each batch's keys decoded (and its samples prefetched) while the batch before is placed.
+  void CopyVertices(const Chunk& chunk, std::int64_t base, std::int64_t v0, std::int64_t v1)
+  {
+    LocalMesh& m = this->Mesh;
+    const LocalMesh& from = chunk.Mesh;
+    constexpr int B = SampledVolume<Values>::VertexBatch;
+    struct Batch
+    {
+      int Points[B][3];
+      int Axis[B];
+      std::int64_t To[B];
+      int Count = 0;
+    } batches[2];
+    std::int64_t next = v0;
+    auto fill = [&](Batch& b)
+    {
+      b.Count = 0;
+      for (; next < v1 && b.Count < B; ++next)
+      {
+        const std::int64_t to = chunk.FinalId[next];
+        if (to < base)
+        {
+          continue; // the chunk below's vertex
+        }
+        this->Volume.GridOf.Decode(from.Keys[next], b.Points[b.Count], b.Axis[b.Count]);
+        this->Volume.PrefetchAround(
+          b.Points[b.Count][0], b.Points[b.Count][1], b.Points[b.Count][2]);
+        b.To[b.Count++] = to;
+        m.Keys[to] = from.Keys[next];
+        m.VertexComponent[to] = from.VertexComponent[next];
+      }
+    };
+    fill(batches[0]);
+    for (int current = 0; batches[current].Count > 0; current = 1 - current)
+    {
+      fill(batches[1 - current]);
+      this->PlaceVertices(batches[current].Points, batches[current].Axis, batches[current].To,
+        batches[current].Count, this->Volume.Options.DoublePoints,
+        this->Volume.Options.ComputeNormals);
+    }
   }
 
   /// The positions and normals of `n` vertices on the edges leaving p[v] along axis[v] (-1: on
