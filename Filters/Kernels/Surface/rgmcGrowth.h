@@ -174,36 +174,48 @@ public:
       this->MakeWork(tile); // the scan reads every tile
     }
     std::vector<int> tileComponents(static_cast<std::size_t>(numTiles), 0);
-    // Tiles in slabs of tiles along z, for the progress reported between them.
+    // Tiles in steps of whole slabs of tiles along z, at least ScanStepTiles a step: progress
+    // between steps on large volumes, and on small ones few steps, each as long as its longest
+    // tile (the tiles are independent: one step of them all would do, but report nothing).
     const std::int64_t perSlab = this->Tiles[0] * this->Tiles[1];
-    for (std::int64_t z = 0; z < this->Tiles[2] && !this->Volume.Stopped(); ++z)
+    const std::int64_t slabsPerStep = std::max<std::int64_t>(1, ScanStepTiles / perSlab);
+    for (std::int64_t z = 0; z < this->Tiles[2] && !this->Volume.Stopped(); z += slabsPerStep)
     {
-      this->Volume.Parallel(perSlab,
+      const std::int64_t zEnd = std::min<std::int64_t>(this->Tiles[2], z + slabsPerStep);
+      this->Volume.Parallel((zEnd - z) * perSlab,
         [&](std::int64_t n)
         {
           const std::int64_t tile = z * perSlab + n;
           tileComponents[tile] = this->ScanTile(tile);
         });
-      this->Volume.Report(0.5 * (z + 1) / this->Tiles[2]);
+      this->Volume.Report(0.5 * zEnd / this->Tiles[2]);
     }
     if (this->Volume.Stopped())
     {
       return;
     }
-    // Tile-local component labels become this rank's: tile by tile, in tile order.
+    // Tile-local component labels become this rank's: tile by tile, in tile order (each tile's
+    // first label counted here, its nodes relabelled on threads).
+    std::vector<int> firstLabel(static_cast<std::size_t>(numTiles));
     for (std::int64_t tile = 0; tile < numTiles; ++tile)
     {
-      const int first = this->Components.Size();
+      firstLabel[tile] = this->Components.Size();
       for (int c = 0; c < tileComponents[tile]; ++c)
       {
         this->Components.Add(false);
       }
-      TileWork& w = this->WorkOf(tile);
-      for (SurfaceNode& n : w.Queue)
+    }
+    this->Volume.Parallel(numTiles,
+      [&](std::int64_t tile)
       {
-        n.Component += first;
-      }
-      this->Found.Append(w.Queue);
+        for (SurfaceNode& n : this->WorkOf(tile).Queue)
+        {
+          n.Component += firstLabel[tile];
+        }
+      });
+    for (std::int64_t tile = 0; tile < numTiles; ++tile)
+    {
+      this->Found.Append(this->WorkOf(tile).Queue);
     }
   }
 
@@ -240,6 +252,9 @@ public:
   }
 
 private:
+  // The full scan: at least this many tiles a parallel step (4096: all of a 512^3 volume's).
+  static constexpr std::int64_t ScanStepTiles = 4096;
+
   /// Grows, as a new component, from the nodes that use vertex `key` (at grid point p; axis < 0
   /// for a grid-point key) unless they were all found; rounds until no tile has work. Returns
   /// the component, or -1 when nothing new was found (`seen` says whether it was found before).
