@@ -203,44 +203,90 @@ private:
     }
   };
 
-  /// Each vertex's sum of this rank's terms, on threads (each range with its own list), in
-  /// SumTerms' order, from TriangleAtVertex. Owned shared vertices are summed again with every
-  /// holder's terms (SumSharedTerms); the other shared ones get their owner's.
+  /// Each vertex's sum of this rank's terms, on threads, in SumTerms' order (TriangleAtVertex).
+  /// Owned shared vertices are summed again with every holder's terms (SumSharedTerms); the
+  /// other shared ones get their owner's.
   void SumOwnTerms(rgmc::OverwriteVector<double>& sums) const
   {
-    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
     rgmc::ParallelFor(this->NumVertices, RowGrain,
       [&](vtkIdType first, vtkIdType last)
       {
-        std::vector<TriangleAtVertex> around;
+        std::vector<TriangleAtVertex> around; // for fans larger than SmallFan
         for (vtkIdType v = first; v < last; ++v)
         {
-          around.clear();
-          for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
-          {
-            const vtkIdType t = this->Corners[c] / 3;
-            const std::pair<vtkIdType, vtkIdType> ends = this->AroundCorner(this->Corners[c]);
-            vtkIdType a = gid[ends.first];
-            vtkIdType b = gid[ends.second];
-            if (b < a)
-            {
-              std::swap(a, b);
-            }
-            around.push_back(TriangleAtVertex{ a, b, t });
-          }
-          std::sort(around.begin(), around.end());
           double* n = &sums[3 * v];
-          n[0] = n[1] = n[2] = 0;
-          for (const TriangleAtVertex& at : around)
+          if (!this->SumSmallFan(v, n))
           {
-            for (int k = 0; k < 3; ++k)
-            {
-              n[k] += this->TriangleCross[3 * at.Triangle + k];
-            }
+            this->SumLargeFan(v, around, n);
           }
           vtkMath::Normalize(n);
         }
       });
+  }
+
+  static constexpr int SmallFan = 16;
+
+  /// The sum at a vertex of at most SmallFan triangles, with no list and no sort: each
+  /// triangle's place in TriangleAtVertex's order is counted, equal pairs kept in corner order
+  /// (std::sort sorts so few by insertion, which keeps them so). False, with nothing summed,
+  /// for a larger fan.
+  bool SumSmallFan(vtkIdType v, double n[3]) const
+  {
+    const vtkIdType first = this->CornerOffsets[v];
+    const int count = static_cast<int>(this->CornerOffsets[v + 1] - first);
+    if (count > SmallFan)
+    {
+      return false;
+    }
+    const vtkIdType* gid = this->Numbering.Gid.data();
+    vtkIdType a[SmallFan], b[SmallFan], triangle[SmallFan], order[SmallFan];
+    for (int i = 0; i < count; ++i)
+    {
+      const std::pair<vtkIdType, vtkIdType> ends = this->AroundCorner(this->Corners[first + i]);
+      a[i] = std::min(gid[ends.first], gid[ends.second]);
+      b[i] = std::max(gid[ends.first], gid[ends.second]);
+      triangle[i] = this->Corners[first + i] / 3;
+    }
+    for (int i = 0; i < count; ++i)
+    {
+      int place = 0;
+      for (int j = 0; j < count; ++j)
+      {
+        place += a[j] < a[i] || (a[j] == a[i] && (b[j] < b[i] || (b[j] == b[i] && j < i)));
+      }
+      order[place] = triangle[i];
+    }
+    n[0] = n[1] = n[2] = 0;
+    for (int p = 0; p < count; ++p)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        n[k] += this->TriangleCross[3 * order[p] + k];
+      }
+    }
+    return true;
+  }
+
+  /// The sum at a vertex of more than SmallFan triangles, sorted in a list.
+  void SumLargeFan(vtkIdType v, std::vector<TriangleAtVertex>& around, double n[3]) const
+  {
+    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
+    around.clear();
+    for (vtkIdType c = this->CornerOffsets[v]; c < this->CornerOffsets[v + 1]; ++c)
+    {
+      const std::pair<vtkIdType, vtkIdType> ends = this->AroundCorner(this->Corners[c]);
+      around.push_back(TriangleAtVertex{ std::min(gid[ends.first], gid[ends.second]),
+        std::max(gid[ends.first], gid[ends.second]), this->Corners[c] / 3 });
+    }
+    std::sort(around.begin(), around.end());
+    n[0] = n[1] = n[2] = 0;
+    for (const TriangleAtVertex& at : around)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        n[k] += this->TriangleCross[3 * at.Triangle + k];
+      }
+    }
   }
 
   /// Owned shared vertices: their own terms and every holder's, in the same order.
