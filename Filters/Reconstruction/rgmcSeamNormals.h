@@ -225,6 +225,7 @@ private:
   }
 
   static constexpr int SmallFan = 16;
+  static constexpr vtkIdType FanPrefetch = 256;
 
   /// The sum at a vertex of at most SmallFan triangles, with no list and no sort: each
   /// triangle's place in TriangleAtVertex's order is counted, equal pairs kept in corner order
@@ -239,6 +240,17 @@ private:
       return false;
     }
     const vtkIdType* gid = this->Numbering.Gid.data();
+    // The triangles of the vertex about 40 ahead (FanPrefetch corners) are asked for early: they
+    // lie all over the mesh (measured: the normals about 10% faster on the 512^3 skull).
+    const vtkIdType ahead = first + FanPrefetch;
+    const vtkIdType aheadEnd =
+      std::min(ahead + count, static_cast<vtkIdType>(this->Corners.size()));
+    for (vtkIdType c = ahead; c < aheadEnd; ++c)
+    {
+      const vtkIdType t = this->Corners[c] / 3;
+      __builtin_prefetch(this->Triangles + 3 * t);
+      __builtin_prefetch(this->TriangleCross.data() + 3 * t);
+    }
     vtkIdType a[SmallFan], b[SmallFan], triangle[SmallFan], order[SmallFan];
     for (int i = 0; i < count; ++i)
     {
