@@ -94,6 +94,15 @@ protected:
   std::vector<I> Owned; // the vertices this rank moves, one stencil row each
   rgmc::Stencils<I> Stencil;
 
+  /// Per vertex, the order in which the normals sum its triangles when OrientedFanRow found
+  /// them an oriented fan of at most MaxOrderedFan: 4 bits a place, each the corner's index in
+  /// the vertex's corner list (SeamNormals' order, found here from the neighbours' ranks
+  /// without looking the gids up again); NoFanOrder for any other vertex. Written by
+  /// OrientedFanRow, each vertex by one thread; released with the normals.
+  static constexpr int MaxOrderedFan = 8;
+  static constexpr std::uint32_t NoFanOrder = ~std::uint32_t(0);
+  mutable rgmc::OverwriteVector<std::uint32_t> FanOrder;
+
 private:
   /// A neighbour held elsewhere, until the remote slots are numbered.
   struct Pending
@@ -152,6 +161,10 @@ private:
       this->Stencil.Offsets.reserve(static_cast<std::size_t>(this->NumVertices) + 1);
       this->Stencil.Neighbours.reserve(static_cast<std::size_t>(3 * this->NumTriangles));
     }
+    this->FanOrder.resize(static_cast<std::size_t>(this->NumVertices));
+    rgmc::ParallelFor(this->NumVertices, RowGrain,
+      [&](vtkIdType first, vtkIdType last)
+      { std::fill(&this->FanOrder[first], &this->FanOrder[first] + (last - first), NoFanOrder); });
     this->AddUnsharedVertices(stencils, checks);
     // Shared vertices this rank owns, in gid order (the order of the received edges).
     for (std::size_t i = 0; i < this->Numbering.SharedVertex.size(); ++i)
@@ -396,16 +409,19 @@ private:
     }
     // rank[i]: how many next corners come before next[i]; distinct gids give distinct ranks.
     // matched: the next corners some previous corner equals.
-    int rank[MaxFan];
+    // previousOf[i]: the triangle whose previous corner is next[i] (the last one, if several).
+    int rank[MaxFan], previousOf[MaxFan];
     unsigned ranks = 0, matched = 0;
     for (int i = 0; i < n; ++i)
     {
       int r = 0;
       bool found = false;
+      previousOf[i] = 0;
       for (int j = 0; j < n; ++j)
       {
         r += nextGid[j] < nextGid[i];
         found |= previousGid[j] == nextGid[i];
+        previousOf[i] = previousGid[j] == nextGid[i] ? j : previousOf[i];
       }
       rank[i] = r;
       ranks |= 1u << r;
@@ -423,6 +439,10 @@ private:
     {
       edges += nextGid[i] > self;
     }
+    if (n <= MaxOrderedFan && !this->FanOrder.empty())
+    {
+      this->FanOrder[v] = FanOrderOf(n, rank, previousOf);
+    }
     if (stencils)
     {
       const std::size_t at = row.size();
@@ -433,6 +453,39 @@ private:
       }
     }
     return true;
+  }
+
+  /// The normals' order of an oriented fan of n <= MaxOrderedFan triangles (FanOrder): triangle
+  /// i runs v, next i, previous i; the previous corner of triangle previousOf[j] is next j, so
+  /// both ends of every triangle have a rank, and ranks compare as gids do. Triangles go by
+  /// their ends' ranks, least first, equal pairs in corner order, as SeamNormals sorts them.
+  static std::uint32_t FanOrderOf(int n, const int* rank, const int* previousOf)
+  {
+    int previousRank[MaxOrderedFan];
+    for (int j = 0; j < n; ++j)
+    {
+      previousRank[previousOf[j]] = rank[j];
+    }
+    // Keys made distinct by the corner's index (ties in corner order), the unused ones last:
+    // a fixed count of comparisons, no branch on n.
+    int key[MaxOrderedFan];
+    for (int i = 0; i < MaxOrderedFan; ++i)
+    {
+      key[i] = i < n
+        ? (std::min(rank[i], previousRank[i]) * 16 + std::max(rank[i], previousRank[i])) * 16 + i
+        : 0x7fffffff;
+    }
+    std::uint32_t order = 0;
+    for (int i = 0; i < n; ++i)
+    {
+      int place = 0;
+      for (int j = 0; j < MaxOrderedFan; ++j)
+      {
+        place += key[j] < key[i];
+      }
+      order |= static_cast<std::uint32_t>(i) << (4 * place);
+    }
+    return order;
   }
 
   /// Any vertex: its whole neighbourhood (with the edges other ranks sent, for a shared one:

@@ -66,6 +66,7 @@ public:
       return nullptr;
     }
     rgmc::OverwriteVector<double>().swap(this->TriangleCross);
+    rgmc::OverwriteVector<std::uint32_t>().swap(this->FanOrder);
     this->Update(sums.data(), NormalBackTag);
     auto normals = vtkSmartPointer<vtkFloatArray>::New();
     if (!this->AllRanks.Step("compute normals", problem,
@@ -229,8 +230,9 @@ private:
 
   /// The sum at a vertex of at most SmallFan triangles, with no list and no sort: each
   /// triangle's place in TriangleAtVertex's order is counted, equal pairs kept in corner order
-  /// (std::sort sorts so few by insertion, which keeps them so). False, with nothing summed,
-  /// for a larger fan.
+  /// (std::sort sorts so few by insertion, which keeps them so); or, for an oriented fan the
+  /// stencils' pass ordered (FanOrder), in that order. False, with nothing summed, for a larger
+  /// fan.
   bool SumSmallFan(vtkIdType v, double n[3]) const
   {
     const vtkIdType first = this->CornerOffsets[v];
@@ -239,7 +241,6 @@ private:
     {
       return false;
     }
-    const vtkIdType* gid = this->Numbering.Gid.data();
     // The triangles of the vertex about 40 ahead (FanPrefetch corners) are asked for early: they
     // lie all over the mesh (measured: the normals about 10% faster on the 512^3 skull).
     const vtkIdType ahead = first + FanPrefetch;
@@ -251,6 +252,22 @@ private:
       __builtin_prefetch(this->Triangles + 3 * t);
       __builtin_prefetch(this->TriangleCross.data() + 3 * t);
     }
+    if (!this->FanOrder.empty() && this->FanOrder[v] != this->NoFanOrder)
+    {
+      // The order the stencils' pass found: no gid looked up, no triangle read.
+      const std::uint32_t places = this->FanOrder[v];
+      n[0] = n[1] = n[2] = 0;
+      for (int p = 0; p < count; ++p)
+      {
+        const vtkIdType t = this->Corners[first + ((places >> (4 * p)) & 15u)] / 3;
+        for (int k = 0; k < 3; ++k)
+        {
+          n[k] += this->TriangleCross[3 * t + k];
+        }
+      }
+      return true;
+    }
+    const vtkIdType* gid = this->Numbering.Gid.data();
     vtkIdType a[SmallFan], b[SmallFan], triangle[SmallFan], order[SmallFan];
     for (int i = 0; i < count; ++i)
     {

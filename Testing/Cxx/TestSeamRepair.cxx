@@ -342,6 +342,69 @@ void OrientationDoesNotMatter(
     differ == 0, name << ": reversing every third triangle moved " << differ << " smoothed points");
 }
 
+/// A mesh of the given triangles (`which`, indices into `triangles`, whose corners index `xyz`
+/// and are the points' keys), in double.
+vtkSmartPointer<vtkPolyData> KeyedMesh(
+  const double (*xyz)[3], const vtkIdType (*triangles)[3], const std::vector<int>& which)
+{
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkIdTypeArray> keys;
+  keys->SetName("VertexKey");
+  vtkNew<vtkCellArray> polys;
+  std::map<vtkIdType, vtkIdType> local;
+  for (int t : which)
+  {
+    vtkIdType ids[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      const vtkIdType key = triangles[t][k];
+      auto found = local.find(key);
+      if (found == local.end())
+      {
+        found = local.emplace(key, points->InsertNextPoint(xyz[key])).first;
+        keys->InsertNextValue(key);
+      }
+      ids[k] = found->second;
+    }
+    polys->InsertNextCell(3, ids);
+  }
+  pd->SetPoints(points);
+  pd->SetPolys(polys);
+  pd->GetPointData()->SetGlobalIds(keys);
+  return pd;
+}
+
+/// The normal of the point of key 0, if this piece holds it.
+bool NormalOfKey0(vtkPolyData* pd, double n[3])
+{
+  vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
+  for (vtkIdType p = 0; ids && p < pd->GetNumberOfPoints(); ++p)
+  {
+    if (ids->GetValue(p) == 0 && pd->GetPointData()->GetNormals())
+    {
+      pd->GetPointData()->GetNormals()->GetTuple(p, n);
+      return true;
+    }
+  }
+  return false;
+}
+
+/// Seam Repair with Laplacian smoothing that moves nothing: the normals are computed.
+vtkSmartPointer<vtkPolyData> RepairInPlace(vtkMultiProcessController* c, vtkPolyData* input)
+{
+  vtkNew<vtkRGSeamRepair> r;
+  r->SetController(c);
+  r->SetInputData(input);
+  r->SetSmoothingMethod(vtkRGSeamRepair::LAPLACIAN);
+  r->SetRelaxationFactor(0.0);
+  r->Update();
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->ShallowCopy(r->GetOutput());
+  return out;
+}
+
 /// Normals after smoothing are summed in an order fixed by the mesh, not by the ranks. A fan of
 /// three triangles around vertex 0 whose area vectors are +1e16, -1e16 and +1 along z: summed in
 /// the 1-rank order (A, B, C) that gives (0, 0, 1); summed per rank with rank 0 holding A and C
@@ -354,72 +417,18 @@ void NormalsInCanonicalOrder(vtkMultiProcessController* controller)
   const double xyz[7][3] = { { 0, 0, 0 }, { big, 0, 0 }, { 0, big, 0 }, { 0, -big, 0 },
     { -big, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } };
   const vtkIdType fan[3][3] = { { 0, 1, 2 }, { 0, 3, 4 }, { 0, 5, 6 } }; // A, B, C
-  auto mesh = [&](const std::vector<int>& triangles)
-  {
-    auto pd = vtkSmartPointer<vtkPolyData>::New();
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    vtkNew<vtkIdTypeArray> keys;
-    keys->SetName("VertexKey");
-    vtkNew<vtkCellArray> polys;
-    std::map<vtkIdType, vtkIdType> local;
-    for (int t : triangles)
-    {
-      vtkIdType ids[3];
-      for (int k = 0; k < 3; ++k)
-      {
-        const vtkIdType key = fan[t][k];
-        auto found = local.find(key);
-        if (found == local.end())
-        {
-          found = local.emplace(key, points->InsertNextPoint(xyz[key])).first;
-          keys->InsertNextValue(key);
-        }
-        ids[k] = found->second;
-      }
-      polys->InsertNextCell(3, ids);
-    }
-    pd->SetPoints(points);
-    pd->SetPolys(polys);
-    pd->GetPointData()->SetGlobalIds(keys);
-    return pd;
-  };
-  auto normalOfVertex0 = [](vtkPolyData* pd, double n[3])
-  {
-    vtkIdTypeArray* ids = vtkIdTypeArray::SafeDownCast(pd->GetPointData()->GetGlobalIds());
-    for (vtkIdType p = 0; ids && p < pd->GetNumberOfPoints(); ++p)
-    {
-      if (ids->GetValue(p) == 0 && pd->GetPointData()->GetNormals())
-      {
-        pd->GetPointData()->GetNormals()->GetTuple(p, n);
-        return true;
-      }
-    }
-    return false;
-  };
-  auto repair = [](vtkMultiProcessController* c, vtkPolyData* input)
-  {
-    vtkNew<vtkRGSeamRepair> r;
-    r->SetController(c);
-    r->SetInputData(input);
-    r->SetSmoothingMethod(vtkRGSeamRepair::LAPLACIAN);
-    r->SetRelaxationFactor(0.0);
-    r->Update();
-    auto out = vtkSmartPointer<vtkPolyData>::New();
-    out->ShallowCopy(r->GetOutput());
-    return out;
-  };
+  auto mesh = [&](const std::vector<int>& triangles) { return KeyedMesh(xyz, fan, triangles); };
   vtkNew<vtkDummyController> single;
   double expected[3] = { 0, 0, 0 }, got[3] = { 0, 0, 0 };
-  const bool found = normalOfVertex0(repair(single, mesh({ 0, 1, 2 })), expected);
+  const bool found = NormalOfKey0(RepairInPlace(single, mesh({ 0, 1, 2 })), expected);
   RGMC_CHECK(found && expected[2] == 1.0, "the fan's normal on 1 rank: " << expected[2]);
   const std::vector<int> mine = ranks == 1 ? std::vector<int>{ 0, 2, 1 }
     : rank == 0                            ? std::vector<int>{ 0, 2 }
     : rank == 1                            ? std::vector<int>{ 1 }
                                            : std::vector<int>{};
-  vtkSmartPointer<vtkPolyData> out = repair(controller, mesh(mine));
+  vtkSmartPointer<vtkPolyData> out = RepairInPlace(controller, mesh(mine));
   double mineNormal[4] = { 0, 0, 0, 0 }, all[4] = { 0, 0, 0, 0 };
-  if (normalOfVertex0(out, got) && rank == 0)
+  if (NormalOfKey0(out, got) && rank == 0)
   {
     mineNormal[0] = got[0], mineNormal[1] = got[1], mineNormal[2] = got[2], mineNormal[3] = 1;
   }
@@ -428,6 +437,24 @@ void NormalsInCanonicalOrder(vtkMultiProcessController* controller)
     "the fan's normal on " << ranks << " ranks (triangles in another order): (" << all[0] << ", "
                            << all[1] << ", " << all[2] << "), on 1 rank (" << expected[0] << ", "
                            << expected[1] << ", " << expected[2] << ")");
+}
+
+/// The same for a vertex inside an oriented fan, whose order the stencils' pass finds from its
+/// neighbours' ranks (no sort): triangles T1..T4 around vertex 0, closed, with area vectors
+/// +1e16, -1e16, -1 and 0 along z, given in the order T3, T4, T1, T2. By the keys of their other
+/// corners, T1 (1, 2), T4 (1, 4), T2 (2, 3), T3 (3, 4): 1e16 + 0 - 1e16 - 1 = -1, so the normal
+/// is (0, 0, -1). Summed in the given order, or in reverse, -1 meets 1e16 first and is lost.
+void NormalsOfAnOrientedFan()
+{
+  const double big = 1e8;
+  const double xyz[5][3] = { { 0, 0, 0 }, { big, 0, 0 }, { 0, big, 0 }, { big, 1, 0 },
+    { 1, 0, 0 } };
+  const vtkIdType fan[4][3] = { { 0, 1, 2 }, { 0, 2, 3 }, { 0, 3, 4 }, { 0, 4, 1 } };
+  vtkNew<vtkDummyController> single;
+  double n[3] = { 0, 0, 0 };
+  const bool found = NormalOfKey0(RepairInPlace(single, KeyedMesh(xyz, fan, { 2, 3, 0, 1 })), n);
+  RGMC_CHECK(found && n[0] == 0.0 && n[1] == 0.0 && n[2] == -1.0,
+    "the oriented fan's normal: (" << n[0] << ", " << n[1] << ", " << n[2] << "), not (0, 0, -1)");
 }
 
 void BadInput(vtkMultiProcessController* controller)
@@ -648,6 +675,7 @@ int main(int argc, char* argv[])
     }
   }
   NormalsInCanonicalOrder(controller);
+  NormalsOfAnOrientedFan();
   BadInput(controller);
   Abort(controller);
 
