@@ -420,8 +420,9 @@ private:
       for (int j = 0; j < n; ++j)
       {
         r += nextGid[j] < nextGid[i];
-        found |= previousGid[j] == nextGid[i];
-        previousOf[i] = previousGid[j] == nextGid[i] ? j : previousOf[i];
+        const bool closes = previousGid[j] == nextGid[i];
+        found |= closes;
+        previousOf[i] = closes ? j : previousOf[i];
       }
       rank[i] = r;
       ranks |= 1u << r;

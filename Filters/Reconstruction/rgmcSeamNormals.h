@@ -256,15 +256,12 @@ private:
     {
       // The order the stencils' pass found: no gid looked up, no triangle read.
       const std::uint32_t places = this->FanOrder[v];
-      n[0] = n[1] = n[2] = 0;
+      vtkIdType order[SmallFan];
       for (int p = 0; p < count; ++p)
       {
-        const vtkIdType t = this->Corners[first + ((places >> (4 * p)) & 15u)] / 3;
-        for (int k = 0; k < 3; ++k)
-        {
-          n[k] += this->TriangleCross[3 * t + k];
-        }
+        order[p] = this->Corners[first + ((places >> (4 * p)) & 15u)] / 3;
       }
+      this->SumCrosses(order, static_cast<std::size_t>(count), n);
       return true;
     }
     const vtkIdType* gid = this->Numbering.Gid.data();
@@ -285,15 +282,21 @@ private:
       }
       order[place] = triangle[i];
     }
+    this->SumCrosses(order, static_cast<std::size_t>(count), n);
+    return true;
+  }
+
+  /// The area vectors of `count` triangles summed into n, in the given order.
+  void SumCrosses(const vtkIdType* triangles, std::size_t count, double n[3]) const
+  {
     n[0] = n[1] = n[2] = 0;
-    for (int p = 0; p < count; ++p)
+    for (std::size_t p = 0; p < count; ++p)
     {
       for (int k = 0; k < 3; ++k)
       {
-        n[k] += this->TriangleCross[3 * order[p] + k];
+        n[k] += this->TriangleCross[3 * triangles[p] + k];
       }
     }
-    return true;
   }
 
   /// The sum at a vertex of more than SmallFan triangles, sorted in a list.
@@ -308,14 +311,10 @@ private:
         std::max(gid[ends.first], gid[ends.second]), this->Corners[c] / 3 });
     }
     std::sort(around.begin(), around.end());
-    n[0] = n[1] = n[2] = 0;
-    for (const TriangleAtVertex& at : around)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        n[k] += this->TriangleCross[3 * at.Triangle + k];
-      }
-    }
+    std::vector<vtkIdType> order(around.size());
+    std::transform(around.begin(), around.end(), order.begin(),
+      [](const TriangleAtVertex& at) { return at.Triangle; });
+    this->SumCrosses(order.data(), order.size(), n);
   }
 
   /// Owned shared vertices: their own terms and every holder's, in the same order.
