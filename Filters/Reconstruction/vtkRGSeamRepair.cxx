@@ -401,13 +401,13 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
         run.Points->ShallowCopy(run.Input->GetPoints());
         return;
       }
-      const std::vector<T>& moved = run.Smooth ? repair.Smoothed : copied;
+      const T* moved = run.Smooth ? repair.Smoothed.data() : copied.data();
       vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
       xyz->SetNumberOfComponents(3);
       T* to = rgmc::Allocate(xyz.Get(), 3 * run.Vertices.Count);
       rgmc::ForEachChunk(3 * run.Vertices.Count, rgmc::ElementChunk,
         [&](vtkIdType, vtkIdType first, vtkIdType last)
-        { std::copy(moved.begin() + first, moved.begin() + last, to + first); });
+        { std::copy(moved + first, moved + last, to + first); });
       run.Points->SetData(xyz);
     });
 }
