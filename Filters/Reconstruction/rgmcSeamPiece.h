@@ -221,7 +221,7 @@ struct SeamPiece
   /// gid order.
   vtkIdType VertexOfGid(vtkIdType g) const
   {
-    const std::vector<vtkIdType>& gid = this->Numbering.Gid;
+    const auto& gid = this->Numbering.Gid;
     return *std::lower_bound(this->Vertices.Sorted.begin(), this->Vertices.Sorted.end(), g,
       [&gid](vtkIdType v, vtkIdType key) { return gid[v] < key; });
   }
