@@ -105,10 +105,10 @@ void CheckGroups(const std::vector<int>& keyOf, std::int64_t keys, const char* w
     items[static_cast<std::size_t>(place[keyOf[i]]++)] = static_cast<std::int32_t>(i);
   }
   std::int64_t ranges = 0;
-  for (std::int64_t c = 0; c < n; c += 65536)
+  for (std::int64_t c = 0; c < n; c += rgmc::GroupChunk)
   {
     const auto chunk =
-      std::minmax_element(keyOf.begin() + c, keyOf.begin() + std::min(n, c + 65536));
+      std::minmax_element(keyOf.begin() + c, keyOf.begin() + std::min(n, c + rgmc::GroupChunk));
     ranges += *chunk.second - *chunk.first + 1;
   }
   const bool local = ranges <= 2 * (n + keys);
@@ -243,7 +243,9 @@ int main()
   }
   // Grouping by key: keys that follow the indices as a mesh's vertices follow its corners (some
   // keys without an index, chunk boundaries in every place), and keys scattered at random.
-  for (std::int64_t n : { 0, 1, 5, 65535, 65536, 65537, 400000 })
+  const std::int64_t chunk = rgmc::GroupChunk;
+  for (std::int64_t n : { std::int64_t(0), std::int64_t(1), std::int64_t(5), chunk - 1, chunk,
+         chunk + 1, 4 * chunk - 1, 4 * chunk + 1, std::int64_t(400000) })
   {
     const std::int64_t keys = n / 6 + 50;
     std::vector<int> keyOf(static_cast<std::size_t>(n));
@@ -259,7 +261,7 @@ int main()
     }
     CheckGroups(keyOf, keys, "scattered keys");
   }
-  // As many keys as indices, scattered: refused (5 chunks over 300 000 keys each).
+  // As many keys as indices, scattered: refused (every chunk over nearly all 300 000 keys).
   std::vector<int> scattered(300000);
   for (int& k : scattered)
   {

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace rgmc
@@ -133,7 +134,7 @@ void RadixSort(Vector& values, KeyOf&& keyOf)
 }
 
 /// Values per task of the parallel sorts (fixed: the ranges never depend on the threads).
-constexpr std::size_t RadixRange = 65536;
+constexpr std::size_t RadixRange = 16384;
 
 /// The ranges of the parallel radix sort's tasks over n values.
 struct RadixRanges
@@ -143,9 +144,12 @@ struct RadixRanges
   std::size_t End(std::size_t r) const { return this->N * (r + 1) / this->Count; }
 };
 
-/// One stable pass on digit p from `from` to `to`: each range counts its digits (`place`, one
-/// count a digit value), then each range's first place for each digit value follows the same
-/// value's places in the ranges before it, then each range scatters.
+/// One stable pass on digit p from `from` to `to`: each range counts its digits, then each
+/// range's first place for each digit value follows the same value's places in the ranges before
+/// it, then each range scatters. `place` holds one count a digit value and range, digit-major
+/// (digit d of range r at d * ranges + r), so that the serial sum walks it in memory order; a
+/// range-major table put the ranges' entries of one digit 8-16 KiB apart, in one cache set
+/// (with 62 ranges, the sums took 1.4 ms of the 512^3 skull's sort on one thread).
 template <typename Vector, typename KeyOf, typename Parallel>
 void RadixPass(const Vector& from, Vector& to, const RadixDigits& digits, int p, KeyOf& keyOf,
   Parallel& parallel, const RadixRanges& ranges, std::vector<std::size_t>& place)
@@ -155,28 +159,29 @@ void RadixPass(const Vector& from, Vector& to, const RadixDigits& digits, int p,
   parallel(static_cast<std::int64_t>(ranges.Count),
     [&](std::int64_t r)
     {
-      std::size_t* count = place.data() + r * size;
-      std::fill(count, count + size, std::size_t(0));
+      std::vector<std::size_t> count(size, 0);
       for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
       {
         ++count[digit(from[i])];
       }
+      for (std::size_t d = 0; d < size; ++d)
+      {
+        place[d * ranges.Count + static_cast<std::size_t>(r)] = count[d];
+      }
     });
   std::size_t start = 0;
-  for (std::size_t d = 0; d < size; ++d)
+  for (std::size_t& c : place)
   {
-    for (std::size_t r = 0; r < ranges.Count; ++r)
-    {
-      std::size_t& c = place[r * size + d];
-      const std::size_t here = c;
-      c = start;
-      start += here;
-    }
+    start += std::exchange(c, start);
   }
   parallel(static_cast<std::int64_t>(ranges.Count),
     [&](std::int64_t r)
     {
-      std::size_t* next = place.data() + r * size;
+      std::vector<std::size_t> next(size);
+      for (std::size_t d = 0; d < size; ++d)
+      {
+        next[d] = place[d * ranges.Count + static_cast<std::size_t>(r)];
+      }
       for (std::size_t i = ranges.Begin(r); i < ranges.End(r); ++i)
       {
         to[next[digit(from[i])]++] = from[i];
