@@ -66,7 +66,7 @@ template <typename T, typename I>
 std::vector<double> BorderEdges(
   const SeamPiece<T, I>& piece, const T* positions, const rgmc::VolumeBox& box)
 {
-  rgmc::OverwriteVector<int> faces(static_cast<std::size_t>(piece.NumVertices)); // set below
+  std::vector<int> faces(static_cast<std::size_t>(piece.NumVertices));
   rgmc::ParallelFor(piece.NumVertices, RowGrain,
     [&](vtkIdType first, vtkIdType last)
     {

@@ -31,10 +31,6 @@ constexpr int NumberingTag = 48800, AnswerTag = 48802;
 template <int Words>
 using Identity = std::array<std::uint64_t, Words>;
 
-/// Identities in a vector sized, then written whole on threads (OverwriteVector).
-template <int Words>
-using Identities = rgmc::OverwriteVector<Identity<Words>>;
-
 /// A coordinate as identity bits: -0 and +0 are one coordinate.
 inline std::uint64_t Bits(double v)
 {
@@ -66,9 +62,9 @@ inline std::uint64_t BitsOfWord(vtkIdType word)
 struct LocalVertices
 {
   vtkIdType Count = 0;
-  rgmc::OverwriteVector<vtkIdType> Sorted; // the vertices in identity order
-  std::vector<vtkIdType> VertexOfPoint;    // input point -> vertex (empty: the same number)
-  std::vector<vtkIdType> First; // vertex -> its first input point (empty: the same number)
+  std::vector<vtkIdType> Sorted;        // the vertices in identity order
+  std::vector<vtkIdType> VertexOfPoint; // input point -> vertex (empty: the same number)
+  std::vector<vtkIdType> First;         // vertex -> its first input point (empty: the same number)
 
   bool Merged() const { return !this->VertexOfPoint.empty(); }
   vtkIdType PointOf(vtkIdType v) const { return this->First.empty() ? v : this->First[v]; }
@@ -78,30 +74,16 @@ struct LocalVertices
   }
 };
 
-/// A point with its identity, ordered as a std::pair of the two; an aggregate, so that a vector
-/// of them (IdentifiedPoints) is sized without being zeroed on one thread first.
+/// A point with its identity.
 template <int Words>
-struct IdentifiedPoint
-{
-  Identity<Words> first;
-  vtkIdType second;
-
-  friend bool operator<(const IdentifiedPoint& a, const IdentifiedPoint& b)
-  {
-    return a.first < b.first || (a.first == b.first && a.second < b.second);
-  }
-};
-
-/// Identified points, sized and then written whole (every place, by the sort or on threads).
-template <int Words>
-using IdentifiedPoints = rgmc::OverwriteVector<IdentifiedPoint<Words>>;
+using IdentifiedPoint = std::pair<Identity<Words>, vtkIdType>;
 
 /// The input points with their identities, sorted.
 template <int Words>
-IdentifiedPoints<Words> SortByIdentity(vtkPolyData* input, const vtkIdType* keys)
+rgmc::LargeVector<IdentifiedPoint<Words>> SortByIdentity(vtkPolyData* input, const vtkIdType* keys)
 {
   const vtkIdType n = input->GetNumberOfPoints();
-  IdentifiedPoints<Words> all(static_cast<std::size_t>(n));
+  rgmc::LargeVector<IdentifiedPoint<Words>> all(static_cast<std::size_t>(n));
   // One-word identities (the keys) are sorted packed with their points, one word each, where
   // both fit in 64 bits: a key takes log2 of 4 x the grid points (edge keys, then point keys), an
   // index log2 of the points (a 2048^3 volume leaves room for 500 million points).
@@ -163,8 +145,8 @@ IdentifiedPoints<Words> SortByIdentity(vtkPolyData* input, const vtkIdType* keys
 
 /// The distinct vertices of the `n` sorted points `all`; `ids` gets their identities in order.
 template <int Words>
-LocalVertices DistinctVertices(
-  const IdentifiedPoints<Words>& all, vtkIdType n, Identities<Words>& ids)
+LocalVertices DistinctVertices(const rgmc::LargeVector<IdentifiedPoint<Words>>& all, vtkIdType n,
+  std::vector<Identity<Words>>& ids)
 {
   LocalVertices local;
   // Copies of a vertex (sorted: side by side), looked for on threads, as are the vertices copied
@@ -220,10 +202,11 @@ LocalVertices DistinctVertices(
 /// Sorts the input points by identity into distinct vertices; `ids` gets the vertices'
 /// identities in sorted order.
 template <int Words>
-LocalVertices MergeLocal(vtkPolyData* input, const vtkIdType* keys, Identities<Words>& ids)
+LocalVertices MergeLocal(
+  vtkPolyData* input, const vtkIdType* keys, std::vector<Identity<Words>>& ids)
 {
   rgmc::SpanMark("numbering: sort");
-  const IdentifiedPoints<Words> all = SortByIdentity<Words>(input, keys);
+  const rgmc::LargeVector<IdentifiedPoint<Words>> all = SortByIdentity<Words>(input, keys);
   rgmc::SpanMark("numbering: distinct vertices");
   LocalVertices local = DistinctVertices<Words>(all, input->GetNumberOfPoints(), ids);
   rgmc::SpanMark("numbering: global ids");
@@ -234,7 +217,7 @@ LocalVertices MergeLocal(vtkPolyData* input, const vtkIdType* keys, Identities<W
 /// ones.
 struct GlobalNumbering
 {
-  rgmc::OverwriteVector<vtkIdType> Gid; // by vertex (written whole)
+  std::vector<vtkIdType> Gid; // by vertex
   enum : unsigned char
   {
     Alone = 0,   // no other rank holds the vertex
@@ -259,7 +242,7 @@ template <int Words>
 class IdentityNumbering
 {
 public:
-  IdentityNumbering(Ranks& ranks, const LocalVertices& vertices, Identities<Words>& ids)
+  IdentityNumbering(Ranks& ranks, const LocalVertices& vertices, std::vector<Identity<Words>>& ids)
     : AllRanks(ranks)
     , Vertices(vertices)
     , Ids(ids)
@@ -292,7 +275,7 @@ public:
             });
           numbering.Holding.assign(
             static_cast<std::size_t>(this->Vertices.Count), GlobalNumbering::Alone);
-          Identities<Words>().swap(this->Ids);
+          std::vector<Identity<Words>>().swap(this->Ids);
         });
     }
     const std::vector<bool> everyone(this->AllRanks.Size, true);
@@ -386,7 +369,7 @@ private:
         }
       }
     }
-    Identities<Words>().swap(this->Ids);
+    std::vector<Identity<Words>>().swap(this->Ids);
   }
 
   /// Merges the ranks' sorted streams of this range and numbers the distinct identities in
@@ -510,7 +493,7 @@ private:
 
   Ranks& AllRanks;
   const LocalVertices& Vertices;
-  Identities<Words>& Ids;               // this rank's, sorted (released once sent)
+  std::vector<Identity<Words>>& Ids;    // this rank's, sorted (released once sent)
   std::vector<vtkIdType> SampleOffsets; // per rank, into AllSamples (in words)
   std::vector<vtkIdType> AllSamples;
   std::vector<std::size_t> SliceStart; // per range: its first identity of this rank's

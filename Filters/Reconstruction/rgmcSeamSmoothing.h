@@ -53,7 +53,7 @@ public:
     // The stencils are done with: the normals need the memory.
     rgmc::OverwriteVector<I>().swap(this->Stencil.Neighbours);
     rgmc::OverwriteVector<std::int64_t>().swap(this->Stencil.Offsets);
-    rgmc::OverwriteVector<I>().swap(this->Owned);
+    std::vector<I>().swap(this->Owned);
     if (!this->AllRanks.Agree(true, problem) || aborted)
     {
       return false;
@@ -62,9 +62,7 @@ public:
     return true;
   }
 
-  /// Positions of this rank's vertices after smoothing: sized, then written whole on threads
-  /// (a zeroed vector was faulted in and zeroed on one thread: 1.3 ms of the span's 12).
-  rgmc::OverwriteVector<T> Smoothed;
+  std::vector<T> Smoothed; // positions of this rank's vertices after smoothing
 
 private:
   /// Jacobi Laplacian, in double, rounded once at the end.
@@ -132,8 +130,7 @@ private:
     const std::function<bool(double)>& progress, bool& aborted, std::string& problem)
   {
     const std::size_t size = 3 * (this->NumVertices + this->RemoteGids.size());
-    std::vector<T> a, b, c;
-    rgmc::OverwriteVector<T> sum; // becomes Smoothed
+    std::vector<T> a, b, c, sum;
     std::vector<double> coefficients;
     if (!this->AllRanks.Step("smooth the surface", problem,
           [&]()
@@ -149,7 +146,7 @@ private:
               }
             }
             c.resize(size);
-            sum.assign(size, T());
+            sum.resize(size);
             coefficients =
               rgmc::SincCoefficients(settings.Iterations, settings.PassBand, settings.Window);
           }))

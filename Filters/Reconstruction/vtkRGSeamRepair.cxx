@@ -49,7 +49,6 @@ using rgmc::Ranks;
 using rgmc::seam::BorderTest;
 using rgmc::seam::Checks;
 using rgmc::seam::GlobalNumbering;
-using rgmc::seam::Identities;
 using rgmc::seam::Identity;
 using rgmc::seam::IdentityNumbering;
 using rgmc::seam::LocalVertices;
@@ -227,7 +226,7 @@ bool vtkRGSeamRepair::NumberVertices(Run& run)
   auto number = [&run](auto words)
   {
     constexpr int Words = decltype(words)::value;
-    Identities<Words> ids;
+    std::vector<Identity<Words>> ids;
     return run.Ranks.Step("sort the vertices", run.Problem,
              [&]() { run.Vertices = rgmc::seam::MergeLocal<Words>(run.Input, run.Keys, ids); }) &&
       IdentityNumbering<Words>(run.Ranks, run.Vertices, ids).Number(run.Numbering, run.Problem);
@@ -402,13 +401,13 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
         run.Points->ShallowCopy(run.Input->GetPoints());
         return;
       }
-      const T* moved = run.Smooth ? repair.Smoothed.data() : copied.data();
+      const std::vector<T>& moved = run.Smooth ? repair.Smoothed : copied;
       vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
       xyz->SetNumberOfComponents(3);
       T* to = rgmc::Allocate(xyz.Get(), 3 * run.Vertices.Count);
       rgmc::ForEachChunk(3 * run.Vertices.Count, rgmc::ElementChunk,
         [&](vtkIdType, vtkIdType first, vtkIdType last)
-        { std::copy(moved + first, moved + last, to + first); });
+        { std::copy(moved.begin() + first, moved.begin() + last, to + first); });
       run.Points->SetData(xyz);
     });
 }
