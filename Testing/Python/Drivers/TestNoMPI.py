@@ -12,12 +12,13 @@ pattern that matches nothing) and says so.
   python3 TestNoMPI.py --readelf readelf --nm nm --plugin-dir DIR [--module LIB] --control LIB
 """
 
-import argparse
-import glob
 import os
 import re
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+import rgmc_testing  # noqa: E402
 
 MPI_LIBRARY = re.compile(r"^lib(mpi|mpich|open-rte|open-pal|pmix)[^/]*\.so")
 MPI_SYMBOL = re.compile(r"^(P?MPI_|ompi_|MPIR_)")
@@ -40,19 +41,10 @@ def mpi_symbols(nm, path):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    for name in ("--readelf", "--nm", "--plugin-dir", "--control"):
-        parser.add_argument(name, required=True)
-    parser.add_argument("--module", action="append", default=[],
-                        help="a library of the plugin kept outside its directory")
-    args = parser.parse_args()
-    objects = sorted(set(os.path.realpath(p) for p in
-                         glob.glob(os.path.join(args.plugin_dir, "*.so*")) + args.module
-                         if os.path.isfile(p)))
-    failures = 0
-    if not any(os.path.basename(p) == "RGMarchingCubes.so" for p in objects):
-        print("FAILED: no RGMarchingCubes.so in %s (found %s)" % (args.plugin_dir, objects))
+    args, objects = rgmc_testing.linkage_arguments()
+    if objects is None:
         return 1
+    failures = 0
     for path in objects:
         libraries, needed = mpi_libraries(args.readelf, path)
         symbols, undefined = mpi_symbols(args.nm, path)

@@ -14,12 +14,13 @@ matches nothing) and says so.
   python3 TestOwnCalls.py --readelf readelf --nm nm --plugin-dir DIR [--module LIB] --control LIB
 """
 
-import argparse
-import glob
 import os
 import re
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Modules"))
+import rgmc_testing  # noqa: E402
 
 SECTION = re.compile(r"^Relocation section '([^']+)'")
 
@@ -59,19 +60,10 @@ def own_calls_through_plt(readelf, nm, path):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    for name in ("--readelf", "--nm", "--plugin-dir", "--control"):
-        parser.add_argument(name, required=True)
-    parser.add_argument("--module", action="append", default=[],
-                        help="a library of the plugin kept outside its directory")
-    args = parser.parse_args()
-    objects = sorted(set(os.path.realpath(p) for p in
-                         glob.glob(os.path.join(args.plugin_dir, "*.so*")) + args.module
-                         if os.path.isfile(p)))
-    failures = 0
-    if not any(os.path.basename(p) == "RGMarchingCubes.so" for p in objects):
-        print("FAILED: no RGMarchingCubes.so in %s (found %s)" % (args.plugin_dir, objects))
+    args, objects = rgmc_testing.linkage_arguments()
+    if objects is None:
         return 1
+    failures = 0
     for path in objects:
         own, plt, defined = own_calls_through_plt(args.readelf, args.nm, path)
         print("%s: %d PLT calls, %d functions defined, %d own functions called through the PLT %s"

@@ -3,6 +3,7 @@ shown in the test's log, how to start MPI and a private X server on every Debian
 where the scripts that run inside ParaView are (Testing/Python/InParaView)."""
 
 import argparse
+import glob
 import os
 import subprocess
 import sys
@@ -23,6 +24,25 @@ failures = []
 def in_paraview(name):
     """The path of `name`, a script that pvbatch, pvpython or the GUI runs for a test."""
     return os.path.join(IN_PARAVIEW, name)
+
+
+def linkage_arguments():
+    """The arguments of the tests that read the plugin's shared objects (TestNoMPI, TestOwnCalls):
+    --readelf, --nm, --plugin-dir, --control, and --module (a library of the plugin kept outside
+    its directory, repeated); then the objects, real paths, sorted. None (having said why) when
+    RGMarchingCubes.so is not among them."""
+    parser = argparse.ArgumentParser()
+    for name in ("--readelf", "--nm", "--plugin-dir", "--control"):
+        parser.add_argument(name, required=True)
+    parser.add_argument("--module", action="append", default=[],
+                        help="a library of the plugin kept outside its directory")
+    args = parser.parse_args()
+    found = glob.glob(os.path.join(args.plugin_dir, "*.so*")) + args.module
+    objects = sorted(set(os.path.realpath(p) for p in found if os.path.isfile(p)))
+    if not any(os.path.basename(p) == "RGMarchingCubes.so" for p in objects):
+        print("FAILED: no RGMarchingCubes.so in %s (found %s)" % (args.plugin_dir, objects))
+        return args, None
+    return args, objects
 
 
 def check(condition, what):
