@@ -137,8 +137,7 @@ struct Stencils
 };
 
 // Each step below updates the rows [first, last) (all by default); rows are independent, so
-// ranges of rows may run on threads at once with the same result. Row r moves vertex points[r]
-// (`points`: any vector of vertex ids).
+// ranges of rows may run on threads at once with the same result.
 
 /// How many stencil entries ahead LaplacianStep prefetches a neighbour's position.
 constexpr std::int64_t LaplacianPrefetch = 128;
@@ -146,9 +145,9 @@ constexpr std::int64_t LaplacianPrefetch = 128;
 /// One Jacobi Laplacian step for the vertices `points[r]` with stencil row r:
 /// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T
 /// (Seam Repair iterates in double and rounds to the points' type once, at the end).
-template <typename T, typename Index, typename Points>
-void LaplacianStep(const Stencils<Index>& stencils, const Points& points, const T* cur, T* next,
-  double relaxation, std::size_t first = 0, std::size_t last = SIZE_MAX)
+template <typename T, typename Index>
+void LaplacianStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* cur,
+  T* next, double relaxation, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
   // The neighbours' positions are gathered from all over the mesh: the one LaplacianPrefetch
   // stencil entries ahead is asked for early (about 20 rows; measured: the step about 10% faster on
@@ -209,9 +208,9 @@ void SincDelta(
 
 /// The first windowed-sinc step (Taubin): x1 = x0 - 0.5 * sum((x0 - y0) / n),
 /// x3 = c0 x0 + c1 x1 (x1 before it is stored).
-template <typename T, typename Index, typename Points>
-void SincFirstStep(const Stencils<Index>& stencils, const Points& points, const T* x0, T* x1, T* x3,
-  const double* c, std::size_t first = 0, std::size_t last = SIZE_MAX)
+template <typename T, typename Index>
+void SincFirstStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* x0,
+  T* x1, T* x3, const double* c, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
   for (std::size_t r = first; r < std::min(last, points.size()); ++r)
   {
@@ -230,9 +229,9 @@ void SincFirstStep(const Stencils<Index>& stencils, const Points& points, const 
 
 /// A later windowed-sinc step: x2 = x1 - x0 + x1 - sum((x1 - y1) / n), x3 += c x2 (x2 before it
 /// is stored).
-template <typename T, typename Index, typename Points>
-void SincStep(const Stencils<Index>& stencils, const Points& points, const T* x0, const T* x1,
-  T* x2, T* x3, double c, std::size_t first = 0, std::size_t last = SIZE_MAX)
+template <typename T, typename Index>
+void SincStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* x0,
+  const T* x1, T* x2, T* x3, double c, std::size_t first = 0, std::size_t last = SIZE_MAX)
 {
   for (std::size_t r = first; r < std::min(last, points.size()); ++r)
   {
