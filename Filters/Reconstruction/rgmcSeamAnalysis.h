@@ -91,7 +91,7 @@ public:
   }
 
 protected:
-  std::vector<I> Owned; // the vertices this rank moves, one stencil row each
+  rgmc::HeapOverwriteVector<I> Owned; // the vertices this rank moves, one stencil row each
   rgmc::Stencils<I> Stencil;
 
   /// Per vertex, the order in which the normals sum its triangles when OrientedFanRow found

@@ -66,7 +66,7 @@ template <typename T, typename I>
 std::vector<double> BorderEdges(
   const SeamPiece<T, I>& piece, const T* positions, const rgmc::VolumeBox& box)
 {
-  std::vector<int> faces(static_cast<std::size_t>(piece.NumVertices));
+  rgmc::HeapOverwriteVector<int> faces(static_cast<std::size_t>(piece.NumVertices)); // set below
   rgmc::ParallelFor(piece.NumVertices, RowGrain,
     [&](vtkIdType first, vtkIdType last)
     {

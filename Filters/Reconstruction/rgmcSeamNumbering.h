@@ -31,6 +31,10 @@ constexpr int NumberingTag = 48800, AnswerTag = 48802;
 template <int Words>
 using Identity = std::array<std::uint64_t, Words>;
 
+/// Identities in a vector sized, then written whole on threads (HeapOverwriteVector).
+template <int Words>
+using Identities = rgmc::HeapOverwriteVector<Identity<Words>>;
+
 /// A coordinate as identity bits: -0 and +0 are one coordinate.
 inline std::uint64_t Bits(double v)
 {
@@ -62,9 +66,9 @@ inline std::uint64_t BitsOfWord(vtkIdType word)
 struct LocalVertices
 {
   vtkIdType Count = 0;
-  std::vector<vtkIdType> Sorted;        // the vertices in identity order
-  std::vector<vtkIdType> VertexOfPoint; // input point -> vertex (empty: the same number)
-  std::vector<vtkIdType> First;         // vertex -> its first input point (empty: the same number)
+  rgmc::HeapOverwriteVector<vtkIdType> Sorted; // the vertices in identity order
+  std::vector<vtkIdType> VertexOfPoint;        // input point -> vertex (empty: the same number)
+  std::vector<vtkIdType> First; // vertex -> its first input point (empty: the same number)
 
   bool Merged() const { return !this->VertexOfPoint.empty(); }
   vtkIdType PointOf(vtkIdType v) const { return this->First.empty() ? v : this->First[v]; }
@@ -74,16 +78,30 @@ struct LocalVertices
   }
 };
 
-/// A point with its identity.
+/// A point with its identity, ordered as a std::pair of the two; an aggregate, so that a vector
+/// of them (IdentifiedPoints) is sized without being zeroed on one thread first.
 template <int Words>
-using IdentifiedPoint = std::pair<Identity<Words>, vtkIdType>;
+struct IdentifiedPoint
+{
+  Identity<Words> first;
+  vtkIdType second;
+
+  friend bool operator<(const IdentifiedPoint& a, const IdentifiedPoint& b)
+  {
+    return a.first < b.first || (a.first == b.first && a.second < b.second);
+  }
+};
+
+/// Identified points, sized and then written whole (every place, by the sort or on threads).
+template <int Words>
+using IdentifiedPoints = rgmc::HeapOverwriteVector<IdentifiedPoint<Words>>;
 
 /// The input points with their identities, sorted.
 template <int Words>
-rgmc::LargeVector<IdentifiedPoint<Words>> SortByIdentity(vtkPolyData* input, const vtkIdType* keys)
+IdentifiedPoints<Words> SortByIdentity(vtkPolyData* input, const vtkIdType* keys)
 {
   const vtkIdType n = input->GetNumberOfPoints();
-  rgmc::LargeVector<IdentifiedPoint<Words>> all(static_cast<std::size_t>(n));
+  IdentifiedPoints<Words> all(static_cast<std::size_t>(n));
   // One-word identities (the keys) are sorted packed with their points, one word each, where
   // both fit in 64 bits: a key takes log2 of 4 x the grid points (edge keys, then point keys), an
   // index log2 of the points (a 2048^3 volume leaves room for 500 million points).
@@ -145,8 +163,8 @@ rgmc::LargeVector<IdentifiedPoint<Words>> SortByIdentity(vtkPolyData* input, con
 
 /// The distinct vertices of the `n` sorted points `all`; `ids` gets their identities in order.
 template <int Words>
-LocalVertices DistinctVertices(const rgmc::LargeVector<IdentifiedPoint<Words>>& all, vtkIdType n,
-  std::vector<Identity<Words>>& ids)
+LocalVertices DistinctVertices(
+  const IdentifiedPoints<Words>& all, vtkIdType n, Identities<Words>& ids)
 {
   LocalVertices local;
   // Copies of a vertex (sorted: side by side), looked for on threads, as are the vertices copied
@@ -202,11 +220,10 @@ LocalVertices DistinctVertices(const rgmc::LargeVector<IdentifiedPoint<Words>>& 
 /// Sorts the input points by identity into distinct vertices; `ids` gets the vertices'
 /// identities in sorted order.
 template <int Words>
-LocalVertices MergeLocal(
-  vtkPolyData* input, const vtkIdType* keys, std::vector<Identity<Words>>& ids)
+LocalVertices MergeLocal(vtkPolyData* input, const vtkIdType* keys, Identities<Words>& ids)
 {
   rgmc::SpanMark("numbering: sort");
-  const rgmc::LargeVector<IdentifiedPoint<Words>> all = SortByIdentity<Words>(input, keys);
+  const IdentifiedPoints<Words> all = SortByIdentity<Words>(input, keys);
   rgmc::SpanMark("numbering: distinct vertices");
   LocalVertices local = DistinctVertices<Words>(all, input->GetNumberOfPoints(), ids);
   rgmc::SpanMark("numbering: global ids");
@@ -217,7 +234,7 @@ LocalVertices MergeLocal(
 /// ones.
 struct GlobalNumbering
 {
-  std::vector<vtkIdType> Gid; // by vertex
+  rgmc::HeapOverwriteVector<vtkIdType> Gid; // by vertex (written whole)
   enum : unsigned char
   {
     Alone = 0,   // no other rank holds the vertex
@@ -242,7 +259,7 @@ template <int Words>
 class IdentityNumbering
 {
 public:
-  IdentityNumbering(Ranks& ranks, const LocalVertices& vertices, std::vector<Identity<Words>>& ids)
+  IdentityNumbering(Ranks& ranks, const LocalVertices& vertices, Identities<Words>& ids)
     : AllRanks(ranks)
     , Vertices(vertices)
     , Ids(ids)
@@ -275,7 +292,7 @@ public:
             });
           numbering.Holding.assign(
             static_cast<std::size_t>(this->Vertices.Count), GlobalNumbering::Alone);
-          std::vector<Identity<Words>>().swap(this->Ids);
+          Identities<Words>().swap(this->Ids);
         });
     }
     const std::vector<bool> everyone(this->AllRanks.Size, true);
@@ -369,7 +386,7 @@ private:
         }
       }
     }
-    std::vector<Identity<Words>>().swap(this->Ids);
+    Identities<Words>().swap(this->Ids);
   }
 
   /// Merges the ranks' sorted streams of this range and numbers the distinct identities in
@@ -493,7 +510,7 @@ private:
 
   Ranks& AllRanks;
   const LocalVertices& Vertices;
-  std::vector<Identity<Words>>& Ids;    // this rank's, sorted (released once sent)
+  Identities<Words>& Ids;               // this rank's, sorted (released once sent)
   std::vector<vtkIdType> SampleOffsets; // per rank, into AllSamples (in words)
   std::vector<vtkIdType> AllSamples;
   std::vector<std::size_t> SliceStart; // per range: its first identity of this rank's

@@ -49,6 +49,7 @@ using rgmc::Ranks;
 using rgmc::seam::BorderTest;
 using rgmc::seam::Checks;
 using rgmc::seam::GlobalNumbering;
+using rgmc::seam::Identities;
 using rgmc::seam::Identity;
 using rgmc::seam::IdentityNumbering;
 using rgmc::seam::LocalVertices;
@@ -226,7 +227,7 @@ bool vtkRGSeamRepair::NumberVertices(Run& run)
   auto number = [&run](auto words)
   {
     constexpr int Words = decltype(words)::value;
-    std::vector<Identity<Words>> ids;
+    Identities<Words> ids;
     return run.Ranks.Step("sort the vertices", run.Problem,
              [&]() { run.Vertices = rgmc::seam::MergeLocal<Words>(run.Input, run.Keys, ids); }) &&
       IdentityNumbering<Words>(run.Ranks, run.Vertices, ids).Number(run.Numbering, run.Problem);
@@ -401,13 +402,13 @@ bool vtkRGSeamRepair::RepairSeamsIn(Run& run)
         run.Points->ShallowCopy(run.Input->GetPoints());
         return;
       }
-      const std::vector<T>& moved = run.Smooth ? repair.Smoothed : copied;
+      const T* moved = run.Smooth ? repair.Smoothed.data() : copied.data();
       vtkNew<vtkAOSDataArrayTemplate<T>> xyz;
       xyz->SetNumberOfComponents(3);
       T* to = rgmc::Allocate(xyz.Get(), 3 * run.Vertices.Count);
       rgmc::ForEachChunk(3 * run.Vertices.Count, rgmc::ElementChunk,
         [&](vtkIdType, vtkIdType first, vtkIdType last)
-        { std::copy(moved.begin() + first, moved.begin() + last, to + first); });
+        { std::copy(moved + first, moved + last, to + first); });
       run.Points->SetData(xyz);
     });
 }

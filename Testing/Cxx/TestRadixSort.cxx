@@ -164,9 +164,10 @@ void CheckDigits(std::uint64_t any, std::uint64_t every, int bits, std::vector<i
 }
 
 static_assert(rgmc::LeavesValuesUnset<rgmc::OverwriteVector<Record>>::value &&
+    rgmc::LeavesValuesUnset<rgmc::HeapOverwriteVector<Record>>::value &&
     !rgmc::LeavesValuesUnset<rgmc::LargeVector<Record>>::value &&
     !rgmc::LeavesValuesUnset<std::vector<Record>>::value,
-  "only an OverwriteVector leaves its values unset");
+  "only an OverwriteVector (of either allocator) leaves its values unset");
 
 } // namespace
 

@@ -147,23 +147,53 @@ struct LargeArrayAllocator
 template <typename T>
 using LargeVector = std::vector<T, LargeArrayAllocator<T>>;
 
-/// LargeArrayAllocator whose vectors leave the values they grow by unset (default-initialized:
-/// nothing is written for plain values), for arrays sized first and then written whole, on
-/// threads: their pages are then first touched, and faulted in, by the threads that fill them,
-/// not zeroed on one thread before. Aggregates (std::array) stay unset; std::pair's constructor
-/// zeroes it.
+/// std::allocator for large arrays a filter allocates again on every run (Seam Repair's): from
+/// the C library's heap, whose freed blocks a re-run gets back already faulted in (the slider
+/// re-runs the filters); LargeArrayAllocator's arrays are unmapped when freed and faulted in again,
+/// at about 3 ms per 24 MiB here. Huge pages are asked for the 2 MiB-aligned part of those of 4 MiB
+/// or more (AdviseHugePages), for their first run.
 template <typename T>
-struct OverwriteAllocator : LargeArrayAllocator<T>
+struct HeapArrayAllocator : std::allocator<T>
 {
   using value_type = T;
   template <typename U>
   struct rebind
   {
-    using other = OverwriteAllocator<U>;
+    using other = HeapArrayAllocator<U>;
+  };
+  HeapArrayAllocator() = default;
+  template <typename U>
+  HeapArrayAllocator(const HeapArrayAllocator<U>&) noexcept
+  {
+  }
+  T* allocate(std::size_t n)
+  {
+    T* data = std::allocator<T>::allocate(n);
+    if (WantsHugePages(n * sizeof(T)))
+    {
+      AdviseHugePages(data, n * sizeof(T));
+    }
+    return data;
+  }
+};
+
+/// An allocator (LargeArrayAllocator by default, or HeapArrayAllocator) whose vectors leave the
+/// values they grow by unset (default-initialized: nothing is written for plain values), for
+/// arrays sized first and then written whole, on threads: their pages are then first touched, and
+/// faulted in, by the threads that fill them, not zeroed on one thread before. Aggregates
+/// (std::array) stay unset; std::pair's constructor zeroes it.
+template <typename T, template <typename> class Base = LargeArrayAllocator>
+struct OverwriteAllocator : Base<T>
+{
+  using value_type = T;
+  template <typename U>
+  struct rebind
+  {
+    using other = OverwriteAllocator<U, Base>;
   };
   OverwriteAllocator() = default;
   template <typename U>
-  OverwriteAllocator(const OverwriteAllocator<U>&) noexcept
+  OverwriteAllocator(const OverwriteAllocator<U, Base>&) noexcept
   {
   }
   template <typename U>
@@ -183,14 +213,20 @@ struct OverwriteAllocator : LargeArrayAllocator<T>
 template <typename T>
 using OverwriteVector = std::vector<T, OverwriteAllocator<T>>;
 
-/// True for a vector whose allocator leaves new values unset (OverwriteVector): one that
-/// `vector(n)` hands over untouched, for its first writer to fault in.
+/// An OverwriteVector in the C library's heap (HeapArrayAllocator), for arrays made again on
+/// every run of a filter.
+template <typename T>
+using HeapOverwriteVector = std::vector<T, OverwriteAllocator<T, HeapArrayAllocator>>;
+
+/// True for a vector whose allocator leaves new values unset (OverwriteVector,
+/// HeapOverwriteVector): one that `vector(n)` hands over untouched, for its first writer to fault
+/// in.
 template <typename Vector>
 struct LeavesValuesUnset : std::false_type
 {
 };
-template <typename T>
-struct LeavesValuesUnset<std::vector<T, OverwriteAllocator<T>>> : std::true_type
+template <typename T, template <typename> class Base>
+struct LeavesValuesUnset<std::vector<T, OverwriteAllocator<T, Base>>> : std::true_type
 {
 };
 

@@ -136,8 +136,8 @@ struct Stencils
   OverwriteVector<Index> Neighbours;
 };
 
-// Each step below updates the rows [first, last) (all by default); rows are independent, so
-// ranges of rows may run on threads at once with the same result.
+// Each step below updates the rows [first, last) of the vertices `points` (one per row); rows are
+// independent, so ranges of rows may run on threads at once with the same result.
 
 /// How many stencil entries ahead LaplacianStep prefetches a neighbour's position.
 constexpr std::int64_t LaplacianPrefetch = 128;
@@ -146,14 +146,14 @@ constexpr std::int64_t LaplacianPrefetch = 128;
 /// next = cur + relaxation * sum(cur[w] - cur) / n. Coordinates are 3 per point, of type T
 /// (Seam Repair iterates in double and rounds to the points' type once, at the end).
 template <typename T, typename Index>
-void LaplacianStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* cur,
-  T* next, double relaxation, std::size_t first = 0, std::size_t last = SIZE_MAX)
+void LaplacianStep(const Stencils<Index>& stencils, const Index* points, const T* cur, T* next,
+  double relaxation, std::size_t first, std::size_t last)
 {
   // The neighbours' positions are gathered from all over the mesh: the one LaplacianPrefetch
   // stencil entries ahead is asked for early (about 20 rows; measured: the step about 10% faster on
   // the 512^3 skull, where nearer or much farther gains less or loses).
   const std::int64_t total = static_cast<std::int64_t>(stencils.Neighbours.size());
-  for (std::size_t r = first; r < std::min(last, points.size()); ++r)
+  for (std::size_t r = first; r < last; ++r)
   {
     const std::int64_t v = points[r];
     const std::int64_t begin = stencils.Offsets[r], end = stencils.Offsets[r + 1];
@@ -209,10 +209,10 @@ void SincDelta(
 /// The first windowed-sinc step (Taubin): x1 = x0 - 0.5 * sum((x0 - y0) / n),
 /// x3 = c0 x0 + c1 x1 (x1 before it is stored).
 template <typename T, typename Index>
-void SincFirstStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* x0,
-  T* x1, T* x3, const double* c, std::size_t first = 0, std::size_t last = SIZE_MAX)
+void SincFirstStep(const Stencils<Index>& stencils, const Index* points, const T* x0, T* x1, T* x3,
+  const double* c, std::size_t first, std::size_t last)
 {
-  for (std::size_t r = first; r < std::min(last, points.size()); ++r)
+  for (std::size_t r = first; r < last; ++r)
   {
     const std::int64_t v = points[r];
     double delta[3];
@@ -230,10 +230,10 @@ void SincFirstStep(const Stencils<Index>& stencils, const std::vector<Index>& po
 /// A later windowed-sinc step: x2 = x1 - x0 + x1 - sum((x1 - y1) / n), x3 += c x2 (x2 before it
 /// is stored).
 template <typename T, typename Index>
-void SincStep(const Stencils<Index>& stencils, const std::vector<Index>& points, const T* x0,
-  const T* x1, T* x2, T* x3, double c, std::size_t first = 0, std::size_t last = SIZE_MAX)
+void SincStep(const Stencils<Index>& stencils, const Index* points, const T* x0, const T* x1, T* x2,
+  T* x3, double c, std::size_t first, std::size_t last)
 {
-  for (std::size_t r = first; r < std::min(last, points.size()); ++r)
+  for (std::size_t r = first; r < last; ++r)
   {
     const std::int64_t v = points[r];
     double delta[3];
