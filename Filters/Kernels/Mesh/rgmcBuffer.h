@@ -170,10 +170,7 @@ struct HeapArrayAllocator : std::allocator<T>
   T* allocate(std::size_t n)
   {
     T* data = std::allocator<T>::allocate(n);
-    if (WantsHugePages(n * sizeof(T)))
-    {
-      AdviseHugePages(data, n * sizeof(T));
-    }
+    AdviseHugePages(data, n * sizeof(T)); // below 4 MiB: nothing
     return data;
   }
 };
