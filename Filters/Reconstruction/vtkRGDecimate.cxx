@@ -71,16 +71,15 @@ void ReleaseFreeMemory()
 #endif
 }
 
-/// After a pass, whose blocks and messages are freed: a part made in waves (more than
+/// After a wave or a pass, whose blocks and messages are freed: a part made in waves (more than
 /// TrianglesPerWave triangles, where memory is what the waves are for) gives their pages back,
-/// so that the next pass's do not come on top of them (glibc keeps freed memory, the threads'
+/// so that the next one's do not come on top of them (glibc keeps freed memory, the threads'
 /// arenas most of all). Otherwise the next pass, smaller, reuses them: trimmed, they were
 /// faulted in again (the 512^3 skull on 2 threads: 2.84-3.39 -> 2.46-2.90 s, the same peak).
-void ReleaseAfterPass(int waves)
+void ReleaseFreeMemoryInWaves(int waves)
 {
   if (waves > 1)
   {
-    rgmc::SpanMark("release memory");
     ReleaseFreeMemory();
   }
 }
@@ -211,17 +210,15 @@ int vtkRGDecimate::RequestData(
       {
         return fail();
       }
-      if (run.Waves > 1)
-      {
-        ReleaseFreeMemory(); // the wave's meshes and messages
-      }
+      ReleaseFreeMemoryInWaves(run.Waves); // the wave's meshes and messages
     }
     if (!this->KeepCheapest(run, pass >= AllFromPass) || !this->ApplyCollapses(run))
     {
       return fail();
     }
     run.Passes = pass + 1;
-    ReleaseAfterPass(run.Waves); // the pass's blocks and messages are freed
+    rgmc::SpanMark("release memory");
+    ReleaseFreeMemoryInWaves(run.Waves); // the pass's blocks and messages
     this->UpdateProgress(0.05 + 0.8 * (pass + 1) / MaximumPasses);
     if (run.Collapses == 0)
     {
